@@ -1,0 +1,42 @@
+#pragma once
+// Option structs and entry points of the CLI's subcommands. main.cpp (the only CLI11 translation
+// unit) fills the structs and calls these. Every entry point returns an ExitStatus.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace actionshift::cli {
+
+/// Exit codes shared by every command.
+enum ExitStatus : int {
+  kOk = 0,           ///< success
+  kCheckFailed = 1,  ///< a check, gate or verdict failed
+  kBadInput = 2,     ///< bad input or usage
+  kInterrupted = 130,
+};
+
+// ---- core (cmd_core.cpp)
+struct ValidateOptions {
+  std::vector<std::string> paths;  ///< manifest files or directories; empty: the built-in manifests
+  bool quiet = false;              ///< only failures and the summary table
+  bool json = false;               ///< machine-readable report
+};
+int run_validate(const ValidateOptions& o);
+
+struct ContractOptions {
+  std::string input;  ///< JSON text, a file path, or "-"/"" for stdin (one object per line)
+};
+int run_contract_hash(const ContractOptions& o);
+int run_contract_decode(const ContractOptions& o);
+int run_contract_encode(const ContractOptions& o);
+
+struct SplitsGenerateOptions {
+  std::string out_dir = "manifests";
+  std::uint64_t seed = 20260718;
+  std::vector<std::string> rules;  ///< empty: all
+};
+int run_splits_generate(const SplitsGenerateOptions& o);
+
+}  // namespace actionshift::cli

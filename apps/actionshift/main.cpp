@@ -1,0 +1,82 @@
+// The actionshift command-line tool: the only translation unit that includes CLI11.
+// Each subcommand fills an options struct and calls a plain function (commands.hpp).
+// Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
+#include "commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <functional>
+#include <iostream>
+
+using namespace actionshift;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "ActionShift: a benchmark for hidden action-interface adaptation in robot manipulation.\n"
+      "A frozen policy emits canonical actions; a hidden contract re-maps them before the robot's\n"
+      "controller. This tool validates contracts and split manifests, runs evaluations and gates.",
+      "actionshift"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("actionshift ") + ACTIONSHIFT_VERSION);
+  app.footer("Exit codes: 0 ok, 1 a check or gate failed, 2 bad input or usage.");
+  std::function<int()> action;
+
+  // ---- validate
+  cli::ValidateOptions validate_o;
+  auto* validate = app.add_subcommand(
+      "validate",
+      "Validate split manifests and pools: recompute every hash, check grammar coverage, the split\n"
+      "rules' disjointness and regeneration from (rule, seed); print one line per check and a summary.");
+  validate->add_option("paths", validate_o.paths, "Manifest files or directories (default: the built-in manifests)");
+  validate->add_flag("-q,--quiet", validate_o.quiet, "Print only failed checks and the summary table");
+  validate->add_flag("--json", validate_o.json, "Print one JSON report instead of text");
+  validate->callback([&] { action = [&] { return cli::run_validate(validate_o); }; });
+
+  // ---- contract hash | decode | encode
+  auto* contract = app.add_subcommand("contract", "Contract utilities for scripting (JSON in, JSON out, one object per line)");
+  contract->require_subcommand(1);
+  cli::ContractOptions contract_o;
+  auto add_input = [&](CLI::App* c) {
+    c->add_option("input", contract_o.input, "JSON text, a file of JSON lines, or - for stdin (default: stdin)");
+  };
+  auto* hash = contract->add_subcommand(
+      "hash", "Print {sha256, canonical, composition} for a contract object (bare or as {\"contract\": ...})");
+  add_input(hash);
+  hash->callback([&] { action = [&] { return cli::run_contract_hash(contract_o); }; });
+  auto* dec = contract->add_subcommand(
+      "decode",
+      "Decode raw actions: {\"contract\": C, \"raw\": [7 numbers] | [[7], [7], ...], \"rotation\": 3x3 rows |\n"
+      "\"quat_wxyz\": [4] (default identity), \"tracked_target\": [6] (default zeros)} -> {\"canonical\", ...}.\n"
+      "A list of raw actions is decoded statefully (tracked target and lag FIFO from episode start).");
+  add_input(dec);
+  dec->callback([&] { action = [&] { return cli::run_contract_decode(contract_o); }; });
+  auto* enc = contract->add_subcommand(
+      "encode", "Encode a canonical action: {\"contract\", \"canonical\": [7], \"rotation\"|\"quat_wxyz\", \"tracked_target\"} -> {\"raw\"}");
+  add_input(enc);
+  enc->callback([&] { action = [&] { return cli::run_contract_encode(contract_o); }; });
+
+  // ---- splits generate
+  auto* splits = app.add_subcommand("splits", "Split and pool generation");
+  splits->require_subcommand(1);
+  cli::SplitsGenerateOptions gen_o;
+  auto* gen = splits->add_subcommand("generate", "Write the manifests of the seeded rules (docs/splits.md) to a directory");
+  gen->add_option("--out", gen_o.out_dir, "Output directory")->capture_default_str();
+  gen->add_option("--seed", gen_o.seed, "Generator seed")->capture_default_str();
+  gen->add_option("--rule", gen_o.rules, "Only these rules (repeatable; default: all)");
+  gen->callback([&] { action = [&] { return cli::run_splits_generate(gen_o); }; });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "actionshift: error: " << e.what() << " (see --help)\n";
+    return cli::kBadInput;
+  }
+  try {
+    return action ? action() : cli::kBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "actionshift: error: " << e.what() << "\n";
+    return cli::kBadInput;
+  }
+}

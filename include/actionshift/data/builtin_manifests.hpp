@@ -1,0 +1,23 @@
+#pragma once
+/// \file The committed manifests (manifests/*.json), compiled into ActionShift::data.
+
+#include "actionshift/core/manifest.hpp"
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace actionshift::data {
+
+/// Names of the built-in manifests (file stems: "seen", "reference9", "full", ...), sorted.
+std::vector<std::string> builtin_manifest_names();
+
+/// The exact file text of a built-in manifest, or nullopt.
+std::optional<std::string_view> builtin_manifest_text(std::string_view name);
+
+/// Resolves a split or pool: an existing file path is loaded from disk; otherwise a built-in
+/// name. Throws InputError naming the argument and listing the built-in names if neither.
+Manifest resolve_manifest(const std::string& name_or_path);
+
+}  // namespace actionshift::data

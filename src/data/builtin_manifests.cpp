@@ -1,0 +1,37 @@
+#include "actionshift/data/builtin_manifests.hpp"
+
+#include "actionshift/core/error.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <utility>
+
+namespace actionshift::data {
+namespace detail {
+extern const std::pair<std::string_view, const std::string_view*> kBuiltinManifests[];
+extern const int kBuiltinManifestCount;
+}  // namespace detail
+
+std::vector<std::string> builtin_manifest_names() {
+  std::vector<std::string> names;
+  for (int i = 0; i < detail::kBuiltinManifestCount; ++i) names.emplace_back(detail::kBuiltinManifests[i].first);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::optional<std::string_view> builtin_manifest_text(std::string_view name) {
+  for (int i = 0; i < detail::kBuiltinManifestCount; ++i)
+    if (detail::kBuiltinManifests[i].first == name) return *detail::kBuiltinManifests[i].second;
+  return std::nullopt;
+}
+
+Manifest resolve_manifest(const std::string& name_or_path) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(name_or_path, ec)) return Manifest::load(name_or_path);
+  if (auto text = builtin_manifest_text(name_or_path)) return Manifest::parse(*text, "builtin:" + name_or_path);
+  std::string known;
+  for (const auto& n : builtin_manifest_names()) known += (known.empty() ? "" : ", ") + n;
+  throw InputError(name_or_path, "", "no such manifest file and not a built-in name (built-in: " + known + ")");
+}
+
+}  // namespace actionshift::data

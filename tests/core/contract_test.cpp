@@ -1,0 +1,131 @@
+#include "actionshift/core/contract.hpp"
+#include "actionshift/core/reference_contracts.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace actionshift {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+TEST(Contract, IdentityCanonicalJsonAndHashMatchReference) {
+  const Contract id = Contract::identity();
+  EXPECT_EQ(id.to_json(),
+            R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1],"target":"delta"})");
+  EXPECT_EQ(id.sha256(), "6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa");
+  EXPECT_TRUE(id.composition_signature().empty());
+}
+
+TEST(Contract, ReferenceGoldenHashes) {
+  // reference §2.6 and §3
+  const auto seen = reference::representative_contracts("seen");
+  const auto unseen = reference::representative_contracts("unseen_composition");
+  const auto lag = reference::representative_contracts("long_lag");
+  EXPECT_EQ(seen[0].sha256(), "d1bb0bda71fc3b1aff5372b4c4d64823538015fe4d9be25252621523ccff41a6");
+  EXPECT_EQ(seen[1].sha256(), "72c2eb7b5279ca9fee28c0978c2b05d5cdce24edd6e9fb87e3639782374a37c5");
+  EXPECT_EQ(unseen[0].sha256(), "d0e2444c69e70093190cf78310ec67ad7a30af20a395380764d7a990b2634468");
+  EXPECT_EQ(unseen[1].sha256(), "af0651087c490513825cb1253713dae5d4855a5fd115829e8353c2b16f00994e");
+  EXPECT_EQ(lag[0].sha256(), "2f93a8433622284510b4a1d5f75bbdbb8945b8e9adbbc9c7e0ab9dc530363b97");
+  EXPECT_EQ(lag[1].sha256(), "182965a71d658df1bd5e692429afa334ae708460550c2776a449c8dcbec23fa3");
+  EXPECT_EQ(reference::distractor_a().sha256(), "44a1aa9652f9ac2788cfa02a54665f9ed62d588fe8ccf21a334cd3b67a4d28d7");
+  EXPECT_EQ(reference::distractor_b().sha256(), "b904a76d3a73d6a91cd9da7b3cb8a3f74547fcc2c774a0cb26762aa10f73f3e7");
+  EXPECT_EQ(pool_sha256(reference::pool9()), "b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3");
+}
+
+TEST(Contract, SmokeContractHash) {
+  ContractFields f;
+  f.permutation = {1, 0, 2, 4, 3, 5};
+  f.sign = {-1, 1, 1, -1, 1, 1};
+  f.scale = {0.5, 1.5, 1.0, 1.0, 0.75, 1.25};
+  f.gripper_inverted = true;
+  EXPECT_EQ(Contract::make(f).sha256(), "1f5840ca50b1528bfd7d6c471f0c73dc15598e50e1e7cd5a98b10ec78e0e3a92");
+}
+
+TEST(Contract, CompositionSignatureOrderAndNames) {
+  EXPECT_EQ(reference::representative_contracts("unseen_composition")[0].composition_signature(),
+            (std::vector<std::string>{"permutation", "sign", "scale", "target", "frame", "gripper"}));
+  EXPECT_EQ(reference::representative_contracts("long_lag")[0].composition_signature(),
+            (std::vector<std::string>{"permutation", "sign", "scale", "lag", "gripper"}));
+}
+
+TEST(Contract, JsonRoundTrip) {
+  for (const auto& c : reference::pool9()) {
+    EXPECT_EQ(Contract::from_json(c.to_json()), c);
+    EXPECT_EQ(Contract::from_json(c.to_json()).to_json(), c.to_json());
+  }
+}
+
+TEST(Contract, FromJsonCoercesIntegerScalesToFloat) {
+  const auto c = Contract::from_json(
+      R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1,1,1,1,1,1],"sign":[1,1,1,1,1,1],"target":"delta"})");
+  EXPECT_EQ(c.sha256(), Contract::identity().sha256());
+}
+
+// every validation rule, with the reference's message (reference §1.1)
+struct BadCase {
+  const char* json;
+  const char* message;
+};
+
+class ContractValidation : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(ContractValidation, RejectsWithMessage) {
+  EXPECT_THAT([] { Contract::from_json(std::string_view(GetParam().json)); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr(GetParam().message)));
+}
+
+#define BODY(perm, sign, scale, target, frame, lag, grip)                                                         \
+  "{\"frame\":" frame ",\"gripper_inverted\":" grip ",\"lag\":" lag ",\"permutation\":" perm ",\"scale\":" scale \
+  ",\"sign\":" sign ",\"target\":" target "}"
+#define OK_PERM "[0,1,2,3,4,5]"
+#define OK_SIGN "[1,1,1,1,1,1]"
+#define OK_SCALE "[1.0,1.0,1.0,1.0,1.0,1.0]"
+
+INSTANTIATE_TEST_SUITE_P(
+    AllRules, ContractValidation,
+    ::testing::Values(
+        BadCase{"", "contract is not valid JSON"}, BadCase{"{", "contract is not valid JSON"},
+        BadCase{"[1,2]", "contract must be a JSON object"},
+        BadCase{BODY("[]", "[]", "[]", "\"delta\"", "\"base\"", "0", "false"), "contract must have at least one pose component"},
+        BadCase{BODY(OK_PERM, "[1,1]", OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "contract component dimensions must match"},
+        BadCase{BODY("[0,1]", "[1,1]", "[1.0,1.0]", "\"delta\"", "\"base\"", "0", "false"), "contract must have 6 pose components"},
+        BadCase{BODY("[0,1,2,3,4,4]", OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "permutation must be a bijection over component indices"},
+        BadCase{BODY("[0,1,2,3,4,6]", OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "permutation must be a bijection over component indices"},
+        BadCase{BODY(OK_PERM, "[1,1,1,1,1,2]", OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "sign values must be -1 or 1"},
+        BadCase{BODY(OK_PERM, "[1,1,1,1,1,0]", OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "sign values must be -1 or 1"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,-0.5]", "\"delta\"", "\"base\"", "0", "false"), "scale values must be finite and positive"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,0.0]", "\"delta\"", "\"base\"", "0", "false"), "scale values must be finite and positive"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,NaN]", "\"delta\"", "\"base\"", "0", "false"), "contract is not valid JSON"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,1e999]", "\"delta\"", "\"base\"", "0", "false"), "contract is not valid JSON"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,\"1\"]", "\"delta\"", "\"base\"", "0", "false"), "scale must be a list of numbers"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "1.5", "false"), "lag must be an integer"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "true", "false"), "lag must be an integer"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "-1", "false"), "lag must be nonnegative"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "5000", "false"), "lag must be at most 1024"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"relative\"", "\"base\"", "0", "false"), "target must be 'delta' or 'absolute'"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"world\"", "0", "false"), "frame must be 'base' or 'tool'"},
+        BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "0", "1"), "gripper_inverted must be boolean"},
+        BadCase{BODY("[0,1,2,3,4,5.0]", OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "permutation must be a list of integers"},
+        BadCase{R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1],"target":"delta","zeta":1,"alpha":2})",
+                "unknown contract fields: alpha, zeta"},
+        BadCase{R"({"frame":"base","permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1]})",
+                "missing contract fields: gripper_inverted, lag, target"}));
+
+TEST(Contract, TryMakeIsTheNonThrowingTwin) {
+  ContractFields f;
+  f.scale[2] = -1.0;
+  std::string err;
+  EXPECT_FALSE(Contract::try_make(f, &err).has_value());
+  EXPECT_EQ(err, "scale values must be finite and positive");
+  f.scale[2] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(Contract::try_make(f, &err).has_value());
+  f.scale[2] = 1.0;
+  EXPECT_TRUE(Contract::try_make(f, &err).has_value());
+}
+
+}  // namespace
+}  // namespace actionshift
