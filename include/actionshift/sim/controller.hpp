@@ -1,0 +1,53 @@
+#pragma once
+/// \file
+/// The `pd_ee_delta_pose` arm controller (DESIGN section 3): canonical pose delta -> TCP target pose
+/// -> damped-least-squares IK -> joint position targets for the PD drives.
+
+#include "actionshift/sim/kinematics.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace actionshift::sim {
+
+/// Normalised action units: 1 = 0.1 m translation and 0.1 rad rotation per control step.
+inline constexpr double kTranslationPerUnit = 0.1;  ///< [m]
+inline constexpr double kRotationPerUnit = 0.1;     ///< [rad]
+
+/// Finger joint target [m] for a gripper command g (clipped to [-1, 1]): 0.015 + 0.025 g.
+double finger_target(double g);
+
+/// Result of interpreting one canonical pose command (6 numbers).
+struct PoseCommand {
+  Eigen::Vector3d delta_position{Eigen::Vector3d::Zero()};  ///< [m], base frame, after clipping
+  Eigen::Vector3d delta_rotvec{Eigen::Vector3d::Zero()};    ///< [rad], base-aligned axes about the TCP, after clipping
+  bool clipped{false};                                      ///< any component was clipped
+};
+
+/// Clip and scale a canonical pose command: each translation component to [-1, 1], the rotation
+/// vector to norm <= 1, then 1 unit = 0.1 m / 0.1 rad. NO ManiSkill rotation sign flip.
+PoseCommand interpret_pose_command(const Eigen::Matrix<double, 6, 1>& pose);
+
+/// Target TCP pose (base frame) for a command: p + dp, Exp(dr) R.
+Eigen::Isometry3d target_pose(const Eigen::Isometry3d& tcp_in_base, const PoseCommand& cmd);
+
+/// Damped-least-squares CLIK settings.
+struct IkOptions {
+  int max_iterations{20};    ///< Newton-style iterations (full steps)
+  double damping{1e-4};      ///< lambda^2 added to J J^T
+  double tolerance{1e-10};   ///< stop when |error| (m and rad) is below this
+};
+
+/// Result of an IK solve.
+struct IkResult {
+  ChainVector q;                 ///< joint solution, within the chain's limits
+  double error{0.0};             ///< final pose error norm ([m] and [rad] stacked)
+  int iterations{0};
+};
+
+/// Solve for joints reaching `target` (root frame) from q0, clamping to joint limits every iteration.
+/// Returns the best iterate seen. Allocation-free.
+IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                  const Eigen::Isometry3d& target, const IkOptions& options = {});
+
+}  // namespace actionshift::sim

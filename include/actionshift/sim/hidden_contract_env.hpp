@@ -1,0 +1,82 @@
+#pragma once
+/// \file
+/// The hidden-contract environment (DESIGN sections 3, 6): raw action -> core Decoder (frame rotation
+/// = live TCP orientation, or identity) -> pd_ee_delta_pose controller. The agent-facing type has
+/// no way to reach the contract; the evaluation-only OracleRecorder, built by the runner from the
+/// same env, reads it.
+
+#include "actionshift/core/contract.hpp"
+#include "actionshift/core/types.hpp"
+#include "actionshift/sim/env.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+namespace actionshift::sim {
+
+namespace detail {
+struct HiddenEnvImpl;
+}
+
+/// Which rotation the decoder's `tool` frame uses.
+enum class FrameRotation {
+  kLiveTcp,   ///< TCP orientation in the robot base frame, read before the step (default)
+  kIdentity,  ///< R = I: `tool` equals `base` (the reference's headline setting)
+};
+
+/// Agent-facing environment under a hidden contract. Raw actions in (any length: a wrong length
+/// ends the episode with bad_action_shape), observations out. Deliberately has no accessor for the
+/// contract, the decoder or the decoded action (tests/sim/hidden_contract_env_test.cpp pins this).
+class HiddenContractEnv {
+ public:
+  HiddenContractEnv(std::shared_ptr<const EnvModel> model, const Contract& contract,
+                    FrameRotation rotation = FrameRotation::kLiveTcp);
+  ~HiddenContractEnv();
+  HiddenContractEnv(HiddenContractEnv&&) noexcept;
+  HiddenContractEnv& operator=(HiddenContractEnv&&) noexcept;
+
+  /// New episode: env reset (initial state = pure function of seed) and decoder reset.
+  const Eigen::VectorXd& reset(std::uint64_t seed);
+  /// One control step with a raw action. Non-finite, wrong-sized or out-of-range raw actions (and
+  /// decoded actions) end the episode with a safety flag; nothing is simulated for them.
+  const StepResult& step(std::span<const double> raw);
+  const StepResult& step(const Action& raw);
+
+  const StepResult& last() const;
+  const EpisodeStats& episode() const;
+  const ObservationLayout& layout() const;
+  TaskId task() const;
+  int horizon() const;
+
+ private:
+  friend class OracleRecorder;
+  std::unique_ptr<detail::HiddenEnvImpl> impl_;
+};
+
+/// Evaluation-only view of a HiddenContractEnv: the contract and what the oracle needs to encode.
+/// Only the runner constructs it (never hand it to an adapter other than the oracle).
+class OracleRecorder {
+ public:
+  explicit OracleRecorder(const HiddenContractEnv& env) : env_(&env) {}
+
+  const Contract& contract() const;
+  std::string contract_json() const;      ///< canonical JSON (hash input)
+  /// Rotation the next decode will use (live TCP orientation in the base frame, or identity).
+  Mat3 frame_rotation() const;
+  /// The decoder's tracked target before the next step (absolute targets are offsets from it).
+  Pose6 tracked_target() const;
+  /// Raw action that the next step decodes to `canonical` (before lag): core encode() with the
+  /// current R and tracked target.
+  Action encode(const Action& canonical) const;
+  /// Canonical action decoded at each step of this episode (before the lag FIFO).
+  std::span<const Action> decoded() const;
+  /// Action handed to the controller at each step of this episode (after the lag FIFO).
+  std::span<const Action> applied() const;
+
+ private:
+  const HiddenContractEnv* env_;
+};
+
+}  // namespace actionshift::sim

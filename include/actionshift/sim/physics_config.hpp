@@ -1,0 +1,28 @@
+#pragma once
+/// \file
+/// Simulation settings of the Bullet Panda (DESIGN section 4; docs/sim.md explains every default).
+
+#include <cmath>
+
+namespace actionshift::sim {
+
+/// Physics and drive settings. Defaults reproduce ManiSkill's `panda` + pd_ee_delta_pose intent
+/// with the Bullet settings that make a grasp hold (dependency notes section 3).
+struct PhysicsConfig {
+  double control_dt_s{0.05};          ///< one control step (20 Hz)
+  int sim_steps_per_control{5};       ///< 100 Hz simulation steps per control step
+  int substeps_per_sim_step{2};       ///< Bullet steps per simulation step (5 ms physics)
+  int solver_iterations{10};          ///< sequential-impulse iterations per Bullet step
+  double gravity{9.81};               ///< [m/s^2], objects only; the robot is gravity compensated exactly
+  double drive_stiffness{1000.0};     ///< K of ManiSkill's joint PD drive [N m/rad] or [N/m]
+  double drive_damping{100.0};        ///< D of ManiSkill's joint PD drive [N m s/rad] or [N s/m]
+  double arm_force_limit{100.0};      ///< [N m] per arm joint (ManiSkill's drive force limit)
+  double finger_force_limit{100.0};   ///< [N] per finger (ManiSkill); squeeze force is K*|q*-q| below it
+  double default_friction{std::sqrt(0.3)};        ///< per-object Bullet friction; products give 0.3 between objects
+  double finger_friction{1.15 / std::sqrt(0.3)};  ///< finger pads: product with default = 1.15 = PhysX avg(2.0, 0.3)
+  bool finger_gear{true};             ///< btMultiBodyGearConstraint between the fingers (mimic)
+  bool friction_anchors{true};        ///< CF_HAS_FRICTION_ANCHOR on fingers and objects
+  bool arm_joint_limits{false};       ///< limit constraints on the arm joints too (the IK keeps targets inside; fingers always)
+};
+
+}  // namespace actionshift::sim
