@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# usage: install_consumer_test.sh BUILD_DIR CONSUMER_SOURCE_DIR
+set -euo pipefail
+BUILD="$1"
+CONSUMER="$2"
+WORK="$BUILD/install-test"
+rm -rf "$WORK"
+mkdir -p "$WORK"
+cmake --install "$BUILD" --prefix "$WORK/prefix" > "$WORK/install.log"
+cmake -S "$CONSUMER" -B "$WORK/build" -DCMAKE_PREFIX_PATH="$WORK/prefix" -DCMAKE_BUILD_TYPE=Release > "$WORK/configure.log" 2>&1 \
+  || { cat "$WORK/configure.log"; exit 1; }
+cmake --build "$WORK/build" > "$WORK/build.log" 2>&1 || { cat "$WORK/build.log"; exit 1; }
+out=$("$WORK/build/consumer")
+echo "$out"
+grep -q "identity 6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa" <<<"$out"
+grep -q "reference9 pool b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3" <<<"$out"
+echo "install consumer: ok"
