@@ -1,0 +1,203 @@
+#pragma once
+/// \file Gates computed by code (DESIGN §8; reference §8): Gate 0 (backbone competence and wrapper
+/// parity), Gate 1 (privileged ceiling: oracle vs no adaptation), promotion rules, and the
+/// comparison of verdict files that CI uses to catch regressions.
+
+#include "actionshift/eval/record.hpp"
+#include "actionshift/eval/statistics.hpp"
+#include "actionshift/eval/summary.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace actionshift::eval {
+
+// ---------------------------------------------------------------------------------------------
+// Paired comparisons over records
+
+/// Paired bootstrap of success_once, candidate − baseline, pairing episodes by PairKey (same seed,
+/// contract index and episode index ⇒ same initial state). Pairs are sorted by key before
+/// resampling, so the result does not depend on record order.
+/// Throws actionshift::InputError (field "pairing") if a key is duplicated within one side, a key
+/// is present on only one side (the message counts them and names the first), or paired records
+/// disagree on contract_sha256.
+BootstrapInterval paired_difference(const std::vector<EpisodeRecord>& candidate,
+                                    const std::vector<EpisodeRecord>& baseline, double confidence = 0.95,
+                                    std::size_t samples = kBootstrapSamples, std::uint64_t seed = kBootstrapSeed);
+
+/// True iff at least three distinct seeds are given (superiority needs three matched seeds).
+bool superiority_allowed(const std::vector<std::uint64_t>& seeds);
+
+// ---------------------------------------------------------------------------------------------
+// Gate 0: competence floor and wrapper parity (issue 4; reference §8.1)
+
+/// Default competence floor (issue 4).
+inline constexpr double kDefaultCompetenceFloor = 0.5;
+/// Largest absolute success difference for the two-point parity rule (reference: 2 percentage points).
+inline constexpr double kParityTolerance = 0.02;
+
+/// The reference's per-task floors: 0.50 for the cube tasks, 0.20 for peg_insertion_side;
+/// kDefaultCompetenceFloor for any other task.
+double competence_floor(std::string_view task);
+
+/// Which statistic is compared with the competence floor.
+enum class CompetenceRule {
+  wilson_lower,    ///< the Wilson 95 % lower bound must reach the floor (default: a claim with its uncertainty)
+  point_estimate,  ///< the success rate must reach the floor (the reference's rule)
+};
+
+/// Competence of a backbone on a task.
+struct CompetenceVerdict {
+  std::string task;
+  double floor{0.0};
+  CompetenceRule rule{CompetenceRule::wilson_lower};
+  WilsonInterval interval;   ///< success_once with its Wilson interval
+  bool passed{false};
+  std::string reason;        ///< failure: reference string (see competence_verdict); pass: empty
+};
+
+/// Pass iff the chosen statistic ≥ floor. Failure reasons: point_estimate
+/// "success {rate:.4f} below floor {floor:.4f}" (the reference's string); wilson_lower
+/// "success Wilson lower bound {lower:.4f} below floor {floor:.4f}".
+/// Throws std::invalid_argument "at least one episode is required" for total 0.
+CompetenceVerdict competence_verdict(std::string_view task, std::int64_t successes, std::int64_t total,
+                                     double floor = kDefaultCompetenceFloor,
+                                     CompetenceRule rule = CompetenceRule::wilson_lower);
+
+/// Wrapper parity between a reference (unwrapped) and a wrapped run.
+struct ParityVerdict {
+  WilsonInterval reference;          ///< unwrapped success_once
+  WilsonInterval wrapped;            ///< wrapped success_once
+  double tolerance{kParityTolerance};
+  double absolute_difference{0.0};   ///< |reference.rate − wrapped.rate|
+  bool two_point_rule{false};        ///< absolute_difference ≤ tolerance (+1e-12)
+  bool overlap_rule{false};          ///< the Wilson intervals overlap
+  bool passed{false};                ///< two_point_rule OR overlap_rule (alternatives, reference §8.1)
+  std::string reason;                ///< failure: "absolute success difference {d:.4f} exceeds {tol:.4f} and CIs do not overlap"
+};
+
+/// Throws std::invalid_argument "at least one episode is required" if either total is 0.
+ParityVerdict parity_verdict(std::int64_t reference_successes, std::int64_t reference_total,
+                             std::int64_t wrapped_successes, std::int64_t wrapped_total,
+                             double tolerance = kParityTolerance);
+
+/// Gate 0 for one (backbone, task).
+struct Gate0Verdict {
+  std::string backbone;
+  std::string task;
+  CompetenceVerdict competence;             ///< of the unwrapped runs
+  ParityVerdict identity_parity;            ///< unwrapped vs identity-wrapped
+  std::optional<ParityVerdict> oracle_parity;  ///< unwrapped vs oracle through a non-identity contract, if run
+  bool passed{false};                       ///< competence ∧ every parity
+  std::string decision;                     ///< "advance" or "exclude"
+  std::string reason;                       ///< first failing check ("competence: …", "identity parity: …"), or empty
+};
+
+/// Gate 0 over record sets (success_once is counted).
+/// Throws std::invalid_argument "at least one episode is required" for an empty set.
+Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view task,
+                           const std::vector<EpisodeRecord>& unwrapped, const std::vector<EpisodeRecord>& identity,
+                           const std::vector<EpisodeRecord>* oracle_nonidentity = nullptr,
+                           double floor = kDefaultCompetenceFloor, CompetenceRule rule = CompetenceRule::wilson_lower);
+
+/// Verdict file: {"schema_version","gate":"gate0","passed","cells":{"<backbone>/<task>":{...,"verdict"}}}.
+nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts);
+
+// ---------------------------------------------------------------------------------------------
+// Gate 1: privileged ceiling (issue 5; reference §8.2)
+
+/// Gate 1 passes a cell when the oracle reaches this success rate (point estimate)…
+inline constexpr double kGate1OracleMin = 0.95;
+/// …and no adaptation stays at or below this one. Both are the issue's "done when" thresholds: a
+/// near-perfect ceiling, and an interface change that breaks the frozen policy.
+inline constexpr double kGate1NoAdaptMax = 0.05;
+/// Splits that are gated; every other split (long_lag, …) is reported as "descriptive".
+inline constexpr std::string_view kGate1GatedSplits[] = {"seen", "unseen_composition"};
+
+/// One (task, split) of Gate 1.
+struct Gate1Cell {
+  std::string task, split, backbone;
+  std::string verdict;        ///< "pass", "fail", "descriptive" (not gated) or "incomplete" (a method missing)
+  std::string reason;         ///< why, one line
+  std::optional<WilsonInterval> oracle;     ///< success_once of oracle
+  std::optional<WilsonInterval> no_adapt;   ///< success_once of no_adapt
+  std::optional<BootstrapInterval> difference;  ///< paired oracle − no_adapt
+  std::vector<std::uint64_t> seeds;         ///< distinct seeds present
+  bool three_seed_comparison{false};        ///< ≥ 3 matched seeds
+};
+
+/// All Gate 1 cells.
+struct Gate1Report {
+  std::vector<Gate1Cell> cells;   ///< sorted by task, split
+  std::string claim_status;       ///< "matched_three_seed_ceiling_comparison" if every compared cell has 3 seeds, else "descriptive_only"
+  bool passed{false};             ///< every gated cell passes (and there is at least one)
+  std::size_t samples{kBootstrapSamples};
+  std::uint64_t bootstrap_seed{kBootstrapSeed};
+};
+
+/// Gate 1 over records (methods other than oracle and no_adapt are ignored).
+/// Throws actionshift::InputError if a cell mixes backbones or the two methods' episode keys differ.
+Gate1Report gate1(const std::vector<EpisodeRecord>& records, std::size_t samples = kBootstrapSamples,
+                  std::uint64_t bootstrap_seed = kBootstrapSeed);
+
+/// Verdict file (docs/formats.md "Verdict file").
+nlohmann::json gate1_to_json(const Gate1Report& report);
+
+/// Markdown table of the cells.
+std::string gate1_to_markdown(const Gate1Report& report);
+
+// ---------------------------------------------------------------------------------------------
+// Promotion (issue 6; DESIGN §8; reference §8.3)
+
+/// Minimum paired gain in success_once over the matched baseline (5 percentage points).
+inline constexpr double kPromotionMinGain = 0.05;
+/// A one-seed result below this success rate is never promoted (pruning rule).
+inline constexpr double kPruneSuccessFloor = 0.3;
+/// Largest tolerated increase of the flagged-episode rate before it counts as a safety regression.
+inline constexpr double kSafetyRegressionTolerance = 0.01;
+
+/// Promotion decision for a candidate method against its matched baseline.
+struct PromotionVerdict {
+  std::string decision;        ///< "promote", "extend_seeds", "prune" or "reject"
+  std::string reason;          ///< one line
+  std::size_t matched_seeds{0};
+  double candidate_rate{0.0}, baseline_rate{0.0};          ///< success_once
+  BootstrapInterval difference;                            ///< paired candidate − baseline
+  double candidate_probe_steps{0.0}, baseline_probe_steps{0.0};  ///< mean probe steps (the cost axis)
+  double candidate_flag_rate{0.0}, baseline_flag_rate{0.0};      ///< episodes with a safety flag
+  bool five_point_rule{false};    ///< estimate ≥ 0.05 and the 95 % interval excludes 0
+  bool pareto_rule{false};        ///< strictly fewer mean probe steps and a paired success estimate ≥ 0
+  bool safety_regression{false};  ///< flag rate up by > 0.01, or its paired interval lies above 0
+};
+
+/// Rules, in order: (1) one seed and candidate success < 0.3 → "prune"; (2) a safety regression →
+/// "reject"; (3) fewer than 3 matched seeds → "extend_seeds" (run the promotion seeds); (4) the
+/// five-point rule or the Pareto rule → "promote"; otherwise "reject".
+/// Throws actionshift::InputError if the two record sets do not pair (see paired_difference).
+PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate,
+                                   const std::vector<EpisodeRecord>& baseline,
+                                   std::size_t samples = kBootstrapSamples, std::uint64_t seed = kBootstrapSeed);
+
+// ---------------------------------------------------------------------------------------------
+// Verdict files
+
+/// One cell of a verdict comparison.
+struct VerdictChange {
+  std::string cell;       ///< cell key, e.g. "pick_cube/seen"
+  std::string expected;   ///< expected verdict
+  std::string actual;     ///< recomputed verdict ("missing" if absent)
+  bool regression{false}; ///< expected "pass", actual anything else
+  std::string line;       ///< one printable line
+};
+
+/// Compare two verdict files of the same gate cell by cell (every expected cell, then actual-only
+/// cells). Throws actionshift::InputError if either is not a verdict file or the gates differ.
+std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, const nlohmann::json& actual,
+                                            const std::string& expected_source = "expected");
+
+}  // namespace actionshift::eval

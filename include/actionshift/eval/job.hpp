@@ -1,0 +1,106 @@
+#pragma once
+/// \file Job specifications and their content-hash ids (DESIGN §8, docs/formats.md "Job spec").
+///
+/// A job is everything that determines an evaluation's episodes: task, split (name, manifest hash and
+/// contract count), method and parameters, backbone and its hash, pool, calibration, rotation mode,
+/// seed and episode count. Its id is the SHA-256 of its canonical JSON, and its results live in
+/// `<out>/<id>.jsonl` and `<out>/<id>.summary.json`.
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace actionshift::eval {
+
+/// Version of the job spec canonical JSON.
+inline constexpr std::string_view kJobSchemaVersion = "1.0";
+
+/// A split manifest by name and content hash, with the number of evaluation contracts it holds.
+struct SplitRef {
+  std::string name;             ///< e.g. "seen"
+  std::string sha256;           ///< 64-hex manifest hash (`manifest_sha256`)
+  std::int64_t contracts{0};    ///< number of evaluation contracts (> 0)
+  bool operator==(const SplitRef&) const = default;
+};
+
+/// A backbone (frozen policy) by name and content hash.
+struct BackboneRef {
+  std::string name;             ///< e.g. "expert", "mlp", "external:<command>"
+  std::string sha256;           ///< 64-hex hash of its weights or description
+  bool operator==(const BackboneRef&) const = default;
+};
+
+/// A declared contract pool by name and content hash (pool-privileged methods only).
+struct PoolRef {
+  std::string name;             ///< e.g. "reference9"
+  std::string sha256;           ///< 64-hex `pool_sha256`
+  bool operator==(const PoolRef&) const = default;
+};
+
+/// Accepted values of JobSpec::rotation_mode.
+/// "live": tool frame = live TCP orientation (default, DESIGN §3); "identity": R = I (reference v1).
+inline constexpr std::string_view kRotationModes[] = {"live", "identity"};
+
+/// Everything that determines a job's episodes. Equality of ids (not of structs) is identity:
+/// `method_params` is compared as text here but hashed in canonical form.
+struct JobSpec {
+  std::string task;                          ///< task name, e.g. "pick_cube"
+  SplitRef split;                            ///< evaluation split
+  std::string method;                        ///< method name, e.g. "oracle", "no_adapt"
+  std::string method_params{"{}"};           ///< JSON object text of the method's parameters
+  BackboneRef backbone;                      ///< frozen policy
+  std::optional<PoolRef> pool;               ///< declared pool, or none
+  std::optional<std::string> calibration_sha256;  ///< 64-hex calibration hash, or none
+  std::string rotation_mode{"live"};         ///< one of kRotationModes
+  std::uint64_t seed{0};                     ///< experimental seed
+  std::int64_t episodes{0};                  ///< number of episodes (> 0)
+  bool operator==(const JobSpec&) const = default;
+};
+
+/// Throws actionshift::InputError(source, field, reason) if a field is invalid.
+void validate_job(const JobSpec& job, const std::string& source = "job");
+
+/// The hashed object: {"backbone":{"name","sha256"},"calibration_sha256","episodes",
+/// "method":{"name","params"},"pool":{"name","sha256"}|null,"rotation_mode","schema_version",
+/// "seed","split":{"contracts","name","sha256"},"task"}. Validates first.
+nlohmann::json job_to_json(const JobSpec& job);
+
+/// Canonical JSON text of job_to_json (sorted keys, no whitespace, Python-repr floats).
+std::string job_canonical_json(const JobSpec& job);
+
+/// The job id: lowercase 64-hex SHA-256 of job_canonical_json.
+std::string job_id(const JobSpec& job);
+
+/// Inverse of job_to_json; `source` names the document in errors. Unknown keys are rejected.
+JobSpec job_from_json(const nlohmann::json& j, const std::string& source);
+
+/// `<id>.jsonl`
+std::string jsonl_file_name(std::string_view id);
+/// `<id>.summary.json`
+std::string summary_file_name(std::string_view id);
+
+/// Where episode `episode_index` of a job runs.
+struct EpisodeSlot {
+  std::int64_t contract_index{0};     ///< episode_index mod contracts
+  std::int64_t contract_episode{0};   ///< episode_index div contracts: its index within the contract
+};
+
+/// Episodes are dealt round-robin over the split's contracts: episode i runs contract i mod n as
+/// that contract's (i div n)-th episode. A job of N episodes gives each contract ⌊N/n⌋ or ⌈N/n⌉.
+/// Throws std::invalid_argument if contracts ≤ 0 or episode_index < 0.
+EpisodeSlot episode_slot(std::int64_t contracts, std::int64_t episode_index);
+
+/// SplitMix64 finaliser (Steele, Lea & Flood 2014): x + 0x9E3779B97F4A7C15, then
+/// xor-shift-multiply by 0xBF58476D1CE4E5B9 (>>30) and 0x94D049BB133111EB (>>27), then ^ (>>31).
+std::uint64_t splitmix64(std::uint64_t x) noexcept;
+
+/// An episode's seed, the only source of its randomness (initial state, policy noise):
+/// splitmix64(splitmix64(splitmix64(seed) ^ contract_index) ^ episode_index).
+/// A pure function of the three values recorded in the episode's record, so every method sees the
+/// same initial states for the same (seed, contract index, episode index).
+std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept;
+
+}  // namespace actionshift::eval

@@ -1,0 +1,114 @@
+#pragma once
+/// \file Experiment plans: an experiment YAML (`configs/experiments/<name>.yaml`) expands to the
+/// cartesian product of its jobs, written as a JSON plan file and, for a cluster, a Slurm job array
+/// script with one array task per job index (docs/formats.md "Experiment", "Plan file").
+
+#include "actionshift/eval/job.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace actionshift::eval {
+
+/// A method of an experiment with its parameters.
+struct MethodEntry {
+  std::string name;             ///< method name, e.g. "oracle"
+  std::string params{"{}"};     ///< canonical JSON object text of its parameters
+  bool operator==(const MethodEntry&) const = default;
+};
+
+/// An experiment as written in YAML. Keys: name, tasks, splits, methods, seeds, episodes, backbone
+/// (required); pool (default null), rotation_mode (default "live"), description (free text).
+struct Experiment {
+  std::string source;                 ///< file it was read from (for messages)
+  std::string source_sha256;          ///< SHA-256 of the file bytes
+  std::string name;                   ///< experiment name
+  std::string description;            ///< free text, not hashed into jobs
+  std::vector<std::string> tasks;     ///< task names
+  std::vector<std::string> splits;    ///< split names
+  std::vector<MethodEntry> methods;   ///< methods with parameters
+  std::vector<std::uint64_t> seeds;   ///< experimental seeds
+  std::int64_t episodes{0};           ///< episodes per (task, split, method, seed) job
+  std::string backbone;               ///< backbone name
+  std::optional<std::string> pool;    ///< pool name, or none
+  std::string rotation_mode{"live"};  ///< "live" or "identity"
+};
+
+/// Parse experiment YAML text. `source` names it in errors.
+/// Throws actionshift::InputError(source, field, reason) for malformed YAML (source gets `:line`),
+/// an unknown or missing key, a wrong type, an empty or duplicated list entry.
+Experiment parse_experiment(std::string_view yaml_text, const std::string& source);
+
+/// Read and parse an experiment file (as parse_experiment; a missing file is an InputError).
+Experiment load_experiment(const std::string& path);
+
+/// Resolves names to hashed references when a plan is made. Each function throws
+/// actionshift::InputError for an unknown name. `pool` is only called when the experiment names a
+/// pool; empty `calibration` means no calibration hash; empty `check_method` accepts every method.
+struct PlanResolver {
+  std::function<SplitRef(const std::string& task, const std::string& split)> split;
+  std::function<BackboneRef(const std::string& task, const std::string& backbone)> backbone;
+  std::function<PoolRef(const std::string& pool)> pool;
+  std::function<std::optional<std::string>(const std::string& task, const MethodEntry& method)> calibration;
+  std::function<void(const MethodEntry& method)> check_method;
+};
+
+/// One job of a plan.
+struct PlannedJob {
+  std::int64_t index{0};   ///< position in the plan (the Slurm array task id)
+  std::string job_id;      ///< job_id(spec)
+  JobSpec spec;            ///< the job
+};
+
+/// A materialised experiment.
+struct Plan {
+  std::string experiment;       ///< experiment name
+  std::string source;           ///< experiment file
+  std::string source_sha256;    ///< its SHA-256
+  std::vector<PlannedJob> jobs; ///< tasks × splits × methods × seeds, nested in that order (seed innermost)
+};
+
+/// Expand an experiment into its jobs (stable order: tasks, then splits, methods, seeds, each in
+/// file order). Throws actionshift::InputError from the resolver or for an invalid job.
+Plan make_plan(const Experiment& experiment, const PlanResolver& resolver);
+
+/// Plan file object: {"schema_version","experiment","source","source_sha256","job_count","jobs":[{"index","job_id","spec"}]}.
+nlohmann::json plan_to_json(const Plan& plan);
+
+/// Inverse of plan_to_json. Each stored job_id is checked against its recomputed spec hash and each
+/// index against its position. Throws actionshift::InputError(source, field, reason).
+Plan plan_from_json(const nlohmann::json& j, const std::string& source);
+
+/// Read a plan file (as plan_from_json).
+Plan load_plan(const std::string& path);
+
+/// Write a plan file atomically (indented JSON).
+void write_plan(const std::string& path, const Plan& plan);
+
+/// Options of the Slurm array script.
+struct SlurmOptions {
+  std::string plan_path;                  ///< plan file the array tasks read
+  std::string out_dir{"results"};         ///< results directory
+  std::string executable{"actionshift"};  ///< CLI to call (absolute path recommended)
+  unsigned cpus_per_task{2};              ///< `--cpus-per-task`, also passed as `--threads`
+  std::string time_limit{"02:00:00"};     ///< `--time`
+  std::string partition;                  ///< `--partition` (omitted when empty)
+  unsigned max_parallel{0};               ///< array throttle `%N` (0: none)
+};
+
+/// An sbatch script for a job array: task i runs
+/// `actionshift run --plan PLAN --job-index $SLURM_ARRAY_TASK_ID --out DIR --threads CPUS`.
+/// Re-submitting is safe: finished jobs are no-ops and killed ones resume.
+/// Throws std::invalid_argument for an empty plan.
+std::string slurm_array_script(const Plan& plan, const SlurmOptions& options);
+
+/// POSIX shell single-quoting of `s`.
+std::string shell_quote(std::string_view s);
+
+}  // namespace actionshift::eval

@@ -1,0 +1,107 @@
+#pragma once
+/// \file Statistics for evaluation results: Wilson score intervals, percentile bootstrap, paired
+/// success differences and a two-proportion summary (reference §9, Appendix A.3).
+
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace actionshift::eval {
+
+/// z for a two-sided 95 % interval exactly as the reference computes it:
+/// Python's `statistics.NormalDist().inv_cdf(0.975)` = 1.9599639845400536.
+/// \note The issue writes z = 1.959963984540054 (the quantile to 16 digits); that literal parses to
+/// the double one ulp above this one, and with it 0/600 gives a lower bound of 4.3e-19 instead of
+/// the reference's 0.0 (Appendix A.3). The reference's double reproduces every A.3 value bit for bit.
+inline constexpr double kZ95 = 1.9599639845400536;
+/// Default number of bootstrap resamples (DESIGN §8).
+inline constexpr std::size_t kBootstrapSamples = 10000;
+/// Default bootstrap seed (the reference's experimental seed, §7.6).
+inline constexpr std::uint64_t kBootstrapSeed = 20260718;
+
+/// A Wilson score interval for a binomial proportion.
+struct WilsonInterval {
+  std::int64_t successes{0};  ///< number of successes s
+  std::int64_t total{0};      ///< number of trials n (> 0)
+  double rate{0.0};           ///< s / n
+  double lower{0.0};          ///< centre − half-width (not clamped, as the reference)
+  double upper{0.0};          ///< centre + half-width (not clamped: 600/600 gives 1.0000000000000002)
+  double confidence{0.95};    ///< nominal coverage
+  bool operator==(const WilsonInterval&) const = default;
+};
+
+/// Wilson score interval with the reference's formula and no clamping:
+/// p = s/n, d = 1 + z²/n, centre = (p + z²/(2n))/d, half = z·sqrt(p(1−p)/n + z²/(4n²))/d.
+/// `z` defaults to kZ95; `confidence` is recorded only.
+/// Throws std::invalid_argument if total ≤ 0 ("at least one trial is required") or successes ∉ [0, total].
+WilsonInterval wilson_interval(std::int64_t successes, std::int64_t total, double z = kZ95,
+                               double confidence = 0.95);
+
+/// A percentile bootstrap interval of a mean.
+struct BootstrapInterval {
+  double estimate{0.0};        ///< mean of the original sample
+  double lower{0.0};           ///< quantile (1−confidence)/2 of the resampled means
+  double upper{0.0};           ///< quantile 1−(1−confidence)/2 of the resampled means
+  double confidence{0.95};     ///< nominal coverage
+  std::size_t samples{0};      ///< number of resamples
+  std::size_t pairs{0};        ///< sample size (pairs for a paired difference)
+  std::uint64_t seed{0};       ///< RNG seed
+  bool operator==(const BootstrapInterval&) const = default;
+};
+
+/// Uniform integers from std::mt19937_64 (whose output sequence the C++ standard fixes), reduced to
+/// [0, n) by rejection: draws ≥ 2⁶⁴ − (2⁶⁴ mod n) are discarded, then x mod n. The sequence is the
+/// same on every platform and standard library.
+/// \note `std::uniform_int_distribution` is implementation-defined and is deliberately not used.
+class BoundedRng {
+ public:
+  explicit BoundedRng(std::uint64_t seed) : engine_(seed) {}
+  /// Raw engine output.
+  std::uint64_t next_u64() { return engine_(); }
+  /// Uniform in [0, n). Throws std::invalid_argument if n == 0.
+  std::uint64_t below(std::uint64_t n);
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+/// Quantile with linear interpolation between order statistics (numpy's default "linear" method,
+/// position q·(n−1) on the sorted sample). `sorted` must be sorted ascending and non-empty; q ∈ [0,1].
+double linear_quantile(const std::vector<double>& sorted, double q);
+
+/// Percentile bootstrap of the mean of `values`: `samples` resamples of size n drawn with
+/// replacement (indices from BoundedRng(seed)), the resampled means, then linear quantiles.
+/// Throws std::invalid_argument for an empty or non-finite sample, samples == 0, confidence ∉ (0,1).
+BootstrapInterval bootstrap_interval(const std::vector<double>& values, double confidence = 0.95,
+                                     std::size_t samples = kBootstrapSamples,
+                                     std::uint64_t seed = kBootstrapSeed);
+
+/// Paired bootstrap of the success difference candidate − baseline: pair k is
+/// (candidate[k], baseline[k]); pairs are resampled intact. Estimate = mean difference.
+/// Throws std::invalid_argument "paired inputs must contain the same number of episodes" on a length
+/// mismatch, and for empty inputs.
+BootstrapInterval paired_success_difference(const std::vector<bool>& candidate,
+                                            const std::vector<bool>& baseline,
+                                            double confidence = 0.95,
+                                            std::size_t samples = kBootstrapSamples,
+                                            std::uint64_t seed = kBootstrapSeed);
+
+/// Two independent proportions side by side (unpaired): both Wilson intervals, the difference
+/// a − b with Newcombe's hybrid score interval (method 10), and whether the Wilson intervals overlap.
+struct TwoProportionSummary {
+  WilsonInterval a;            ///< first group
+  WilsonInterval b;            ///< second group
+  double difference{0.0};      ///< a.rate − b.rate
+  double lower{0.0};           ///< Newcombe lower bound of the difference
+  double upper{0.0};           ///< Newcombe upper bound of the difference
+  double absolute_difference{0.0};  ///< |a.rate − b.rate|
+  bool intervals_overlap{false};    ///< max(lowers) ≤ min(uppers)
+};
+
+/// Summarise two proportions. Throws as wilson_interval does.
+TwoProportionSummary two_proportion_summary(std::int64_t successes_a, std::int64_t total_a,
+                                            std::int64_t successes_b, std::int64_t total_b,
+                                            double z = kZ95);
+
+}  // namespace actionshift::eval

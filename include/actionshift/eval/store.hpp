@@ -1,0 +1,83 @@
+#pragma once
+/// \file The append-only result store of one job: `<out>/<id>.jsonl` plus `<out>/<id>.summary.json`.
+///
+/// Each record is appended as one whole line by a single write(2) and flushed to the kernel at once,
+/// so a killed process leaves at most one torn (unterminated or unparsable) last line. Opening the
+/// store validates every existing line, repairs such a tail by truncation, and refuses (without
+/// touching the file) anything else that is wrong. The store also holds an exclusive flock(2) on the
+/// JSONL file, so two processes cannot run the same job into the same directory at once.
+
+#include "actionshift/eval/job.hpp"
+#include "actionshift/eval/record.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace actionshift::eval {
+
+/// Options of ResultStore::open.
+struct StoreOptions {
+  bool fsync{false};             ///< fsync(2) after every appended line (slower; survives power loss)
+  std::ostream* log{nullptr};    ///< where repairs are logged (one line each); nullptr: silent
+};
+
+/// An open job result file. Move-only; closes (and unlocks) the file on destruction.
+class ResultStore {
+ public:
+  /// Create `out_dir` if needed, open or create `<out_dir>/<id>.jsonl`, lock it, and scan it.
+  /// Lines must be records 0..k−1 of this job in order (job id, task, split, method, seed, backbone
+  /// and contract index all match). A torn last line is truncated away and logged.
+  /// Throws actionshift::InputError (`<file>:<line>: <field>: <reason>`) on anything else, leaving
+  /// the file unmodified, or if another process holds the lock.
+  static ResultStore open(const std::string& out_dir, const JobSpec& job, const StoreOptions& options = {});
+
+  ResultStore(ResultStore&& other) noexcept;
+  ResultStore& operator=(ResultStore&& other) noexcept;
+  ResultStore(const ResultStore&) = delete;
+  ResultStore& operator=(const ResultStore&) = delete;
+  ~ResultStore();
+
+  const JobSpec& job() const noexcept { return job_; }
+  const std::string& job_id() const noexcept { return id_; }
+  const std::string& jsonl_path() const noexcept { return path_; }          ///< `<out>/<id>.jsonl`
+  const std::string& summary_path() const noexcept { return summary_path_; }  ///< `<out>/<id>.summary.json`
+  /// Records present: existing ones from the scan, then those appended.
+  const std::vector<EpisodeRecord>& records() const noexcept { return records_; }
+  std::int64_t episodes_done() const noexcept { return static_cast<std::int64_t>(records_.size()); }
+  bool complete() const noexcept { return episodes_done() >= job_.episodes; }
+  /// Bytes removed from a torn tail when the store was opened (0: none).
+  std::int64_t repaired_bytes() const noexcept { return repaired_bytes_; }
+
+  /// Append the next record. It must carry this job's id and episode_index == episodes_done().
+  /// Throws std::invalid_argument otherwise, and std::runtime_error if the write fails.
+  void append(const EpisodeRecord& record);
+
+ private:
+  ResultStore() = default;
+  JobSpec job_;
+  std::string id_, path_, summary_path_;
+  std::vector<EpisodeRecord> records_;
+  std::int64_t repaired_bytes_{0};
+  bool fsync_{false};
+  int fd_{-1};
+};
+
+/// Check that `r` is record `episode_index` of `job` (id `id`): throws actionshift::InputError(source,
+/// field, reason) naming the first field that differs.
+void check_record_belongs(const EpisodeRecord& r, const JobSpec& job, const std::string& id,
+                          std::int64_t episode_index, const std::string& source);
+
+/// The job summary object (docs/formats.md "Job summary"): counts, success rates with Wilson
+/// intervals (null when no episode exists), means, safety-flag counts, per-contract rates, the wall
+/// time and episodes of this invocation, and `message`.
+nlohmann::json make_job_summary(const JobSpec& job, const std::vector<EpisodeRecord>& records,
+                                std::int64_t episodes_run, double wall_time_s, const std::string& message);
+
+/// Write a summary atomically (temporary file, fsync, rename) as indented JSON with a final newline.
+void write_json_atomic(const std::string& path, const nlohmann::json& value);
+
+}  // namespace actionshift::eval

@@ -1,0 +1,423 @@
+#include "actionshift/eval/gates.hpp"
+
+#include "actionshift/core/error.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace actionshift::eval {
+
+namespace {
+
+using nlohmann::json;
+
+json wilson_json(const WilsonInterval& w) {
+  return {{"successes", w.successes}, {"total", w.total}, {"rate", w.rate},
+          {"lower", w.lower},         {"upper", w.upper}, {"confidence", w.confidence}};
+}
+
+json bootstrap_json(const BootstrapInterval& b) {
+  return {{"estimate", b.estimate}, {"lower", b.lower},     {"upper", b.upper}, {"confidence", b.confidence},
+          {"samples", b.samples},   {"pairs", b.pairs},     {"seed", b.seed}};
+}
+
+std::string key_text(const PairKey& k) {
+  return "(seed " + std::to_string(k.seed) + ", contract " + std::to_string(k.contract_index) + ", episode " +
+         std::to_string(k.episode_index) + ")";
+}
+
+std::map<PairKey, const EpisodeRecord*> index_by_key(const std::vector<EpisodeRecord>& records, const char* side) {
+  std::map<PairKey, const EpisodeRecord*> out;
+  for (const auto& r : records) {
+    const PairKey k{r.seed, r.contract_index, r.episode_index};
+    if (!out.emplace(k, &r).second)
+      throw InputError("", "pairing", std::string("duplicate ") + side + " episode " + key_text(k));
+  }
+  return out;
+}
+
+// matched (candidate, baseline) pairs sorted by key; throws on any mismatch
+std::vector<std::pair<const EpisodeRecord*, const EpisodeRecord*>> match_pairs(
+    const std::vector<EpisodeRecord>& candidate, const std::vector<EpisodeRecord>& baseline) {
+  const auto c = index_by_key(candidate, "candidate");
+  const auto b = index_by_key(baseline, "baseline");
+  std::size_t only_c = 0, only_b = 0;
+  std::optional<PairKey> first;
+  for (const auto& [k, r] : c)
+    if (!b.count(k)) {
+      ++only_c;
+      if (!first) first = k;
+    }
+  for (const auto& [k, r] : b)
+    if (!c.count(k)) {
+      ++only_b;
+      if (!first || k < *first) first = k;
+    }
+  if (only_c || only_b)
+    throw InputError("", "pairing",
+                     "episode keys differ: " + std::to_string(only_c) + " only in candidate, " + std::to_string(only_b) +
+                         " only in baseline (first " + key_text(*first) + "); finish or remove incomplete jobs");
+  if (c.empty()) throw InputError("", "pairing", "no episodes to pair");
+  std::vector<std::pair<const EpisodeRecord*, const EpisodeRecord*>> out;
+  out.reserve(c.size());
+  for (const auto& [k, r] : c) {
+    const EpisodeRecord* other = b.at(k);
+    if (r->contract_sha256 != other->contract_sha256)
+      throw InputError("", "pairing", "episode " + key_text(k) + " ran different contracts (" +
+                                          r->contract_sha256.substr(0, 12) + " vs " + other->contract_sha256.substr(0, 12) + ")");
+    out.emplace_back(r, other);
+  }
+  return out;
+}
+
+std::vector<std::uint64_t> distinct_seeds(const std::vector<EpisodeRecord>& records) {
+  std::set<std::uint64_t> s;
+  for (const auto& r : records) s.insert(r.seed);
+  return {s.begin(), s.end()};
+}
+
+std::int64_t count_success(const std::vector<EpisodeRecord>& records) {
+  std::int64_t k = 0;
+  for (const auto& r : records) k += r.success_once;
+  return k;
+}
+
+}  // namespace
+
+BootstrapInterval paired_difference(const std::vector<EpisodeRecord>& candidate,
+                                    const std::vector<EpisodeRecord>& baseline, double confidence,
+                                    std::size_t samples, std::uint64_t seed) {
+  const auto pairs = match_pairs(candidate, baseline);
+  std::vector<bool> c, b;
+  for (const auto& [rc, rb] : pairs) {
+    c.push_back(rc->success_once);
+    b.push_back(rb->success_once);
+  }
+  return paired_success_difference(c, b, confidence, samples, seed);
+}
+
+bool superiority_allowed(const std::vector<std::uint64_t>& seeds) {
+  return std::set<std::uint64_t>(seeds.begin(), seeds.end()).size() >= 3;
+}
+
+// ---- Gate 0
+
+double competence_floor(std::string_view task) {
+  if (task == "peg_insertion_side") return 0.20;
+  return kDefaultCompetenceFloor;  // pick_cube, push_cube, pull_cube, stack_cube: 0.50
+}
+
+CompetenceVerdict competence_verdict(std::string_view task, std::int64_t successes, std::int64_t total, double floor,
+                                     CompetenceRule rule) {
+  if (total <= 0) throw std::invalid_argument("at least one episode is required");
+  CompetenceVerdict v;
+  v.task = std::string(task);
+  v.floor = floor;
+  v.rule = rule;
+  v.interval = wilson_interval(successes, total);
+  if (rule == CompetenceRule::point_estimate) {
+    v.passed = v.interval.rate >= floor;
+    if (!v.passed) v.reason = "success " + fixed(v.interval.rate, 4) + " below floor " + fixed(floor, 4);
+  } else {
+    v.passed = v.interval.lower >= floor;
+    if (!v.passed) v.reason = "success Wilson lower bound " + fixed(v.interval.lower, 4) + " below floor " + fixed(floor, 4);
+  }
+  return v;
+}
+
+ParityVerdict parity_verdict(std::int64_t ref_s, std::int64_t ref_n, std::int64_t wrap_s, std::int64_t wrap_n,
+                             double tolerance) {
+  if (ref_n <= 0 || wrap_n <= 0) throw std::invalid_argument("at least one episode is required");
+  ParityVerdict v;
+  v.reference = wilson_interval(ref_s, ref_n);
+  v.wrapped = wilson_interval(wrap_s, wrap_n);
+  v.tolerance = tolerance;
+  v.absolute_difference = std::fabs(v.reference.rate - v.wrapped.rate);
+  v.two_point_rule = v.absolute_difference <= tolerance + 1e-12;
+  v.overlap_rule = std::max(v.reference.lower, v.wrapped.lower) <= std::min(v.reference.upper, v.wrapped.upper);
+  v.passed = v.two_point_rule || v.overlap_rule;
+  if (!v.passed)
+    v.reason = "absolute success difference " + fixed(v.absolute_difference, 4) + " exceeds " + fixed(tolerance, 4) +
+               " and CIs do not overlap";
+  return v;
+}
+
+Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view task, const std::vector<EpisodeRecord>& unwrapped,
+                           const std::vector<EpisodeRecord>& identity, const std::vector<EpisodeRecord>* oracle,
+                           double floor, CompetenceRule rule) {
+  if (unwrapped.empty() || identity.empty() || (oracle && oracle->empty()))
+    throw std::invalid_argument("at least one episode is required");
+  Gate0Verdict v;
+  v.backbone = std::string(backbone);
+  v.task = std::string(task);
+  const auto n_u = static_cast<std::int64_t>(unwrapped.size());
+  const std::int64_t s_u = count_success(unwrapped);
+  v.competence = competence_verdict(task, s_u, n_u, floor, rule);
+  v.identity_parity = parity_verdict(s_u, n_u, count_success(identity), static_cast<std::int64_t>(identity.size()));
+  if (oracle) v.oracle_parity = parity_verdict(s_u, n_u, count_success(*oracle), static_cast<std::int64_t>(oracle->size()));
+  v.passed = v.competence.passed && v.identity_parity.passed && (!v.oracle_parity || v.oracle_parity->passed);
+  v.decision = v.passed ? "advance" : "exclude";
+  if (!v.competence.passed) v.reason = "competence: " + v.competence.reason;
+  else if (!v.identity_parity.passed) v.reason = "identity parity: " + v.identity_parity.reason;
+  else if (v.oracle_parity && !v.oracle_parity->passed) v.reason = "oracle parity: " + v.oracle_parity->reason;
+  return v;
+}
+
+nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
+  auto parity_json = [](const ParityVerdict& p) -> json {
+    return {{"reference", wilson_json(p.reference)}, {"wrapped", wilson_json(p.wrapped)},
+            {"tolerance", p.tolerance},             {"absolute_difference", p.absolute_difference},
+            {"two_point_rule", p.two_point_rule},   {"overlap_rule", p.overlap_rule},
+            {"passed", p.passed},                   {"reason", p.reason}};
+  };
+  json j = {{"schema_version", "1.0"}, {"gate", "gate0"}, {"cells", json::object()}};
+  bool all = !verdicts.empty();
+  for (const auto& v : verdicts) {
+    all = all && v.passed;
+    json c = {{"backbone", v.backbone},
+              {"task", v.task},
+              {"verdict", v.passed ? "pass" : "fail"},
+              {"decision", v.decision},
+              {"reason", v.reason},
+              {"competence",
+               {{"floor", v.competence.floor},
+                {"rule", v.competence.rule == CompetenceRule::wilson_lower ? "wilson_lower" : "point_estimate"},
+                {"interval", wilson_json(v.competence.interval)},
+                {"passed", v.competence.passed},
+                {"reason", v.competence.reason}}},
+              {"identity_parity", parity_json(v.identity_parity)},
+              {"oracle_parity", v.oracle_parity ? parity_json(*v.oracle_parity) : json(nullptr)}};
+    j["cells"][v.backbone + "/" + v.task] = c;
+  }
+  j["passed"] = all;
+  return j;
+}
+
+// ---- Gate 1
+
+Gate1Report gate1(const std::vector<EpisodeRecord>& records, std::size_t samples, std::uint64_t bootstrap_seed) {
+  struct Group {
+    std::vector<EpisodeRecord> oracle, no_adapt;
+    std::set<std::string> backbones;
+  };
+  std::map<std::pair<std::string, std::string>, Group> groups;
+  for (const auto& r : records) {
+    if (r.method != "oracle" && r.method != "no_adapt") continue;
+    Group& g = groups[{r.task, r.split}];
+    (r.method == "oracle" ? g.oracle : g.no_adapt).push_back(r);
+    g.backbones.insert(r.backbone);
+  }
+  Gate1Report report;
+  report.samples = samples;
+  report.bootstrap_seed = bootstrap_seed;
+  bool all_three = true, any_compared = false, any_gated = false, gated_ok = true;
+  for (auto& [key, g] : groups) {
+    Gate1Cell c;
+    c.task = key.first;
+    c.split = key.second;
+    const std::string cell = c.task + "/" + c.split;
+    if (g.backbones.size() > 1)
+      throw InputError("gate1", cell, "mixes backbones (" + *g.backbones.begin() + ", " + *std::next(g.backbones.begin()) +
+                                          "); use one results directory per backbone");
+    c.backbone = *g.backbones.begin();
+    const bool gated = std::find(std::begin(kGate1GatedSplits), std::end(kGate1GatedSplits), c.split) !=
+                       std::end(kGate1GatedSplits);
+    if (!g.oracle.empty()) c.oracle = wilson_interval(count_success(g.oracle), static_cast<std::int64_t>(g.oracle.size()));
+    if (!g.no_adapt.empty())
+      c.no_adapt = wilson_interval(count_success(g.no_adapt), static_cast<std::int64_t>(g.no_adapt.size()));
+    if (c.oracle && c.no_adapt) {
+      try {
+        c.difference = paired_difference(g.oracle, g.no_adapt, 0.95, samples, bootstrap_seed);
+      } catch (const InputError& e) {
+        throw InputError("gate1", cell, "oracle vs no_adapt: " + e.reason());
+      }
+      c.seeds = distinct_seeds(g.oracle);
+      c.three_seed_comparison = superiority_allowed(c.seeds);
+      any_compared = true;
+      all_three = all_three && c.three_seed_comparison;
+      const std::string rates = "oracle " + fixed(c.oracle->rate, 4) + ", no_adapt " + fixed(c.no_adapt->rate, 4);
+      if (!gated) {
+        c.verdict = "descriptive";
+        c.reason = rates + " (split not gated)";
+      } else if (c.oracle->rate >= kGate1OracleMin && c.no_adapt->rate <= kGate1NoAdaptMax) {
+        c.verdict = "pass";
+        c.reason = rates;
+      } else {
+        c.verdict = "fail";
+        if (c.oracle->rate < kGate1OracleMin) c.reason = "oracle " + fixed(c.oracle->rate, 4) + " below " + fixed(kGate1OracleMin, 4);
+        if (c.no_adapt->rate > kGate1NoAdaptMax)
+          c.reason += (c.reason.empty() ? "" : "; ") + std::string("no_adapt ") + fixed(c.no_adapt->rate, 4) + " above " +
+                      fixed(kGate1NoAdaptMax, 4);
+      }
+    } else {
+      c.seeds = distinct_seeds(g.oracle.empty() ? g.no_adapt : g.oracle);
+      c.verdict = gated ? "incomplete" : "descriptive";
+      c.reason = std::string("no ") + (c.oracle ? "no_adapt" : "oracle") + " records";
+    }
+    if (gated) {
+      any_gated = true;
+      gated_ok = gated_ok && c.verdict == "pass";
+    }
+    report.cells.push_back(std::move(c));
+  }
+  report.claim_status = any_compared && all_three ? "matched_three_seed_ceiling_comparison" : "descriptive_only";
+  report.passed = any_gated && gated_ok;
+  return report;
+}
+
+nlohmann::json gate1_to_json(const Gate1Report& report) {
+  json j = {{"schema_version", "1.0"},
+            {"gate", "gate1"},
+            {"thresholds",
+             {{"oracle_min", kGate1OracleMin},
+              {"no_adapt_max", kGate1NoAdaptMax},
+              {"statistic", "success_once point estimate"},
+              {"gated_splits", json::array({kGate1GatedSplits[0], kGate1GatedSplits[1]})}}},
+            {"bootstrap", {{"samples", report.samples}, {"seed", report.bootstrap_seed}, {"confidence", 0.95}}},
+            {"claim_status", report.claim_status},
+            {"passed", report.passed},
+            {"cells", json::object()}};
+  for (const auto& c : report.cells) {
+    j["cells"][c.task + "/" + c.split] = {
+        {"task", c.task},
+        {"split", c.split},
+        {"backbone", c.backbone},
+        {"verdict", c.verdict},
+        {"reason", c.reason},
+        {"oracle", c.oracle ? wilson_json(*c.oracle) : json(nullptr)},
+        {"no_adapt", c.no_adapt ? wilson_json(*c.no_adapt) : json(nullptr)},
+        {"oracle_minus_no_adapt", c.difference ? bootstrap_json(*c.difference) : json(nullptr)},
+        {"seeds", c.seeds},
+        {"three_seed_comparison", c.three_seed_comparison},
+        {"interpretation", "privileged ceiling gap; not an adaptation-method superiority claim"}};
+  }
+  return j;
+}
+
+std::string gate1_to_markdown(const Gate1Report& report) {
+  auto w = [](const std::optional<WilsonInterval>& x) {
+    return x ? fixed(x->rate, 3) + " [" + fixed(x->lower, 3) + ", " + fixed(x->upper, 3) + "]" : std::string("—");
+  };
+  std::ostringstream s;
+  s << "| task | split | oracle (Wilson 95 %) | no_adapt (Wilson 95 %) | paired diff (bootstrap 95 %) | seeds | verdict |\n"
+    << "|---|---|---|---|---|---:|---|\n";
+  for (const auto& c : report.cells) {
+    const std::string d = c.difference ? fixed(c.difference->estimate, 3) + " [" + fixed(c.difference->lower, 3) + ", " +
+                                             fixed(c.difference->upper, 3) + "]"
+                                       : std::string("—");
+    s << "| " << c.task << " | " << c.split << " | " << w(c.oracle) << " | " << w(c.no_adapt) << " | " << d << " | "
+      << c.seeds.size() << " | " << c.verdict << " |\n";
+  }
+  s << "\nclaim status: " << report.claim_status << "; gate 1 " << (report.passed ? "passed" : "not passed") << "\n";
+  return s.str();
+}
+
+// ---- promotion
+
+PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate, const std::vector<EpisodeRecord>& baseline,
+                                   std::size_t samples, std::uint64_t seed) {
+  const auto pairs = match_pairs(candidate, baseline);
+  PromotionVerdict v;
+  const double n = static_cast<double>(pairs.size());
+  std::vector<bool> cs, bs, cf, bf;
+  double c_probe = 0.0, b_probe = 0.0;
+  for (const auto& [c, b] : pairs) {
+    cs.push_back(c->success_once);
+    bs.push_back(b->success_once);
+    cf.push_back(!c->safety_flags.empty());
+    bf.push_back(!b->safety_flags.empty());
+    c_probe += static_cast<double>(c->probe_steps);
+    b_probe += static_cast<double>(b->probe_steps);
+  }
+  v.matched_seeds = distinct_seeds(candidate).size();
+  v.difference = paired_success_difference(cs, bs, 0.95, samples, seed);
+  v.candidate_rate = static_cast<double>(std::count(cs.begin(), cs.end(), true)) / n;
+  v.baseline_rate = static_cast<double>(std::count(bs.begin(), bs.end(), true)) / n;
+  v.candidate_probe_steps = c_probe / n;
+  v.baseline_probe_steps = b_probe / n;
+  v.candidate_flag_rate = static_cast<double>(std::count(cf.begin(), cf.end(), true)) / n;
+  v.baseline_flag_rate = static_cast<double>(std::count(bf.begin(), bf.end(), true)) / n;
+  const BootstrapInterval flag_diff = paired_success_difference(cf, bf, 0.95, samples, seed);
+  v.safety_regression = v.candidate_flag_rate - v.baseline_flag_rate > kSafetyRegressionTolerance || flag_diff.lower > 0.0;
+  v.five_point_rule = v.difference.estimate >= kPromotionMinGain - 1e-12 && v.difference.lower > 0.0;
+  // a Pareto point on (success, probe cost): strictly cheaper, and not less successful
+  v.pareto_rule = v.candidate_probe_steps < v.baseline_probe_steps && v.difference.estimate >= 0.0;
+  const std::string diff = fixed(v.difference.estimate, 4) + " [" + fixed(v.difference.lower, 4) + ", " +
+                           fixed(v.difference.upper, 4) + "]";
+  if (v.matched_seeds == 1 && v.candidate_rate < kPruneSuccessFloor) {
+    v.decision = "prune";
+    v.reason = "one-seed success " + fixed(v.candidate_rate, 4) + " below " + fixed(kPruneSuccessFloor, 4) +
+               "; a sub-0.3 one-seed result is never promoted";
+  } else if (v.safety_regression) {
+    v.decision = "reject";
+    v.reason = "safety regression: flagged-episode rate " + fixed(v.candidate_flag_rate, 4) + " vs baseline " +
+               fixed(v.baseline_flag_rate, 4);
+  } else if (v.matched_seeds < 3) {
+    v.decision = "extend_seeds";
+    v.reason = "superiority requires at least three matched seeds (have " + std::to_string(v.matched_seeds) +
+               "); difference " + diff;
+  } else if (v.five_point_rule || v.pareto_rule) {
+    v.decision = "promote";
+    v.reason = v.five_point_rule ? "difference " + diff + " at least " + fixed(kPromotionMinGain, 4)
+                                 : "Pareto point: probe steps " + fixed(v.candidate_probe_steps, 2) + " vs " +
+                                       fixed(v.baseline_probe_steps, 2) + ", difference " + diff;
+  } else {
+    v.decision = "reject";
+    v.reason = "difference " + diff + " below " + fixed(kPromotionMinGain, 4) + " and no Pareto improvement in probe steps (" +
+               fixed(v.candidate_probe_steps, 2) + " vs " + fixed(v.baseline_probe_steps, 2) + ")";
+  }
+  return v;
+}
+
+// ---- verdict files
+
+std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, const nlohmann::json& actual,
+                                            const std::string& source) {
+  auto check = [&](const json& j, const std::string& name) {
+    if (!j.is_object() || !j.contains("gate") || !j["gate"].is_string() || !j.contains("cells") || !j["cells"].is_object())
+      throw InputError(name, "cells", "not a verdict file (needs \"gate\" and a \"cells\" object)");
+    for (auto it = j["cells"].begin(); it != j["cells"].end(); ++it)
+      if (!it.value().is_object() || !it.value().contains("verdict") || !it.value()["verdict"].is_string())
+        throw InputError(name, "cells." + it.key() + ".verdict", "missing verdict string");
+  };
+  check(expected, source);
+  check(actual, "recomputed verdicts");
+  if (expected["gate"] != actual["gate"])
+    throw InputError(source, "gate", "expected verdicts are for " + expected["gate"].get<std::string>() + ", not " +
+                                         actual["gate"].get<std::string>());
+  std::vector<VerdictChange> out;
+  const json& ec = expected["cells"];
+  const json& ac = actual["cells"];
+  for (auto it = ec.begin(); it != ec.end(); ++it) {
+    VerdictChange c;
+    c.cell = it.key();
+    c.expected = it.value()["verdict"].get<std::string>();
+    const bool present = ac.contains(c.cell);
+    c.actual = present ? ac[c.cell]["verdict"].get<std::string>() : "missing";
+    c.regression = c.expected == "pass" && c.actual != "pass";
+    const std::string reason = present && ac[c.cell].contains("reason") && ac[c.cell]["reason"].is_string()
+                                   ? ac[c.cell]["reason"].get<std::string>()
+                                   : std::string();
+    const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (c.actual == "pass" ? "improved" : "changed");
+    c.line = std::string(tag) + " " + c.cell + ": expected " + c.expected + ", got " + c.actual +
+             (reason.empty() ? "" : " (" + reason + ")");
+    out.push_back(std::move(c));
+  }
+  for (auto it = ac.begin(); it != ac.end(); ++it) {
+    if (ec.contains(it.key())) continue;
+    VerdictChange c;
+    c.cell = it.key();
+    c.expected = "none";
+    c.actual = it.value()["verdict"].get<std::string>();
+    c.line = "new " + c.cell + ": got " + c.actual;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace actionshift::eval

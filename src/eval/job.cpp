@@ -1,0 +1,173 @@
+#include "actionshift/eval/job.hpp"
+
+#include "actionshift/core/canonical_json.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <climits>
+#include <optional>
+#include <set>
+
+namespace actionshift::eval {
+
+namespace {
+
+using nlohmann::json;
+
+void check_hash(const std::string& v, const std::string& src, const std::string& field) {
+  if (!is_sha256_hex(v)) throw InputError(src, field, "expected 64 lowercase hex digits (got \"" + v + "\")");
+}
+
+void check_token(const std::string& v, const std::string& src, const std::string& field) {
+  if (!detail::is_token(v)) throw InputError(src, field, "expected a name of [a-z0-9_.-] (got \"" + v + "\")");
+}
+
+void check_keys(const json& j, const std::set<std::string>& allowed, const std::string& src, const std::string& prefix) {
+  if (!j.is_object()) throw InputError(src, prefix.empty() ? "" : prefix, "expected an object (got " + j.dump() + ")");
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!allowed.count(it.key())) throw InputError(src, prefix.empty() ? it.key() : prefix + "." + it.key(), "unknown field");
+  for (const auto& k : allowed)
+    if (!j.contains(k)) throw InputError(src, prefix.empty() ? k : prefix + "." + k, "missing field");
+}
+
+// a JSON integer ≥ 0, signed or unsigned (values built in memory are signed, parsed ones unsigned)
+std::optional<std::uint64_t> nonneg_int(const json& v) {
+  if (v.is_number_unsigned()) return v.get<std::uint64_t>();
+  if (v.is_number_integer() && v.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(v.get<std::int64_t>());
+  return std::nullopt;
+}
+
+std::string str_at(const json& j, const char* key, const std::string& src, const std::string& field) {
+  const json& v = j.at(key);
+  if (!v.is_string()) throw InputError(src, field, "expected a string (got " + v.dump() + ")");
+  return v.get<std::string>();
+}
+
+json parse_params(const std::string& text, const std::string& src) {
+  json p;
+  try {
+    p = json::parse(text);
+  } catch (const json::parse_error&) {
+    throw InputError(src, "method.params", "malformed JSON object text");
+  }
+  if (!p.is_object()) throw InputError(src, "method.params", "expected a JSON object (got " + p.dump() + ")");
+  return p;
+}
+
+}  // namespace
+
+void validate_job(const JobSpec& job, const std::string& src) {
+  check_token(job.task, src, "task");
+  check_token(job.split.name, src, "split.name");
+  check_hash(job.split.sha256, src, "split.sha256");
+  if (job.split.contracts <= 0) throw InputError(src, "split.contracts", "must be > 0 (got " + std::to_string(job.split.contracts) + ")");
+  check_token(job.method, src, "method.name");
+  const json params = parse_params(job.method_params, src);
+  try {
+    (void)canonical_dump(params);  // rejects non-finite floats
+  } catch (const std::invalid_argument& e) {
+    throw InputError(src, "method.params", e.what());
+  }
+  if (job.backbone.name.empty()) throw InputError(src, "backbone.name", "must not be empty");
+  check_hash(job.backbone.sha256, src, "backbone.sha256");
+  if (job.pool) {
+    check_token(job.pool->name, src, "pool.name");
+    check_hash(job.pool->sha256, src, "pool.sha256");
+  }
+  if (job.calibration_sha256) check_hash(*job.calibration_sha256, src, "calibration_sha256");
+  bool mode_ok = false;
+  for (auto m : kRotationModes) mode_ok = mode_ok || job.rotation_mode == m;
+  if (!mode_ok) throw InputError(src, "rotation_mode", "expected \"live\" or \"identity\" (got \"" + job.rotation_mode + "\")");
+  if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
+}
+
+nlohmann::json job_to_json(const JobSpec& job) {
+  validate_job(job);
+  json j = json::object();
+  j["schema_version"] = std::string(kJobSchemaVersion);
+  j["task"] = job.task;
+  j["split"] = {{"name", job.split.name}, {"sha256", job.split.sha256}, {"contracts", job.split.contracts}};
+  j["method"] = {{"name", job.method}, {"params", parse_params(job.method_params, "job")}};
+  j["backbone"] = {{"name", job.backbone.name}, {"sha256", job.backbone.sha256}};
+  j["pool"] = job.pool ? json{{"name", job.pool->name}, {"sha256", job.pool->sha256}} : json(nullptr);
+  j["calibration_sha256"] = job.calibration_sha256 ? json(*job.calibration_sha256) : json(nullptr);
+  j["rotation_mode"] = job.rotation_mode;
+  j["seed"] = job.seed;
+  j["episodes"] = job.episodes;
+  return j;
+}
+
+std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_to_json(job)); }
+
+std::string job_id(const JobSpec& job) { return sha256_hex(job_canonical_json(job)); }
+
+JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
+  check_keys(j, {"backbone", "calibration_sha256", "episodes", "method", "pool", "rotation_mode", "schema_version",
+                 "seed", "split", "task"},
+             src, "");
+  if (j.at("schema_version") != std::string(kJobSchemaVersion))
+    throw InputError(src, "schema_version", "unsupported job schema version (got " + j.at("schema_version").dump() + ")");
+  JobSpec job;
+  job.task = str_at(j, "task", src, "task");
+  const json& split = j.at("split");
+  check_keys(split, {"contracts", "name", "sha256"}, src, "split");
+  job.split.name = str_at(split, "name", src, "split.name");
+  job.split.sha256 = str_at(split, "sha256", src, "split.sha256");
+  const auto contracts = nonneg_int(split.at("contracts"));
+  if (!contracts || *contracts > static_cast<std::uint64_t>(INT64_MAX))
+    throw InputError(src, "split.contracts", "expected a positive integer");
+  job.split.contracts = static_cast<std::int64_t>(*contracts);
+  const json& method = j.at("method");
+  check_keys(method, {"name", "params"}, src, "method");
+  job.method = str_at(method, "name", src, "method.name");
+  if (!method.at("params").is_object()) throw InputError(src, "method.params", "expected an object");
+  job.method_params = canonical_dump(method.at("params"));
+  const json& backbone = j.at("backbone");
+  check_keys(backbone, {"name", "sha256"}, src, "backbone");
+  job.backbone.name = str_at(backbone, "name", src, "backbone.name");
+  job.backbone.sha256 = str_at(backbone, "sha256", src, "backbone.sha256");
+  const json& pool = j.at("pool");
+  if (!pool.is_null()) {
+    check_keys(pool, {"name", "sha256"}, src, "pool");
+    job.pool = PoolRef{str_at(pool, "name", src, "pool.name"), str_at(pool, "sha256", src, "pool.sha256")};
+  }
+  const json& cal = j.at("calibration_sha256");
+  if (!cal.is_null()) job.calibration_sha256 = str_at(j, "calibration_sha256", src, "calibration_sha256");
+  job.rotation_mode = str_at(j, "rotation_mode", src, "rotation_mode");
+  const auto seed = nonneg_int(j.at("seed"));
+  if (!seed) throw InputError(src, "seed", "expected a non-negative integer");
+  job.seed = *seed;
+  const auto episodes = nonneg_int(j.at("episodes"));
+  if (!episodes || *episodes > static_cast<std::uint64_t>(INT64_MAX))
+    throw InputError(src, "episodes", "expected a positive integer");
+  job.episodes = static_cast<std::int64_t>(*episodes);
+  validate_job(job, src);
+  return job;
+}
+
+std::string jsonl_file_name(std::string_view id) { return std::string(id) + ".jsonl"; }
+std::string summary_file_name(std::string_view id) { return std::string(id) + ".summary.json"; }
+
+EpisodeSlot episode_slot(std::int64_t contracts, std::int64_t episode_index) {
+  if (contracts <= 0) throw std::invalid_argument("episode_slot: contracts must be > 0");
+  if (episode_index < 0) throw std::invalid_argument("episode_slot: episode_index must be >= 0");
+  return {episode_index % contracts, episode_index / contracts};
+}
+
+std::uint64_t splitmix64(std::uint64_t x) noexcept {
+  std::uint64_t z = x + 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept {
+  std::uint64_t h = splitmix64(seed);
+  h = splitmix64(h ^ static_cast<std::uint64_t>(contract_index));
+  return splitmix64(h ^ static_cast<std::uint64_t>(episode_index));
+}
+
+}  // namespace actionshift::eval

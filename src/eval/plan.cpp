@@ -1,0 +1,346 @@
+#include "actionshift/eval/plan.hpp"
+
+#include "actionshift/core/canonical_json.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/eval/store.hpp"
+#include "io.hpp"
+
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace actionshift::eval {
+
+namespace {
+
+using nlohmann::json;
+
+std::string at_line(const std::string& source, const YAML::Node& n) {
+  const auto m = n.Mark();
+  return m.line >= 0 ? source + ":" + std::to_string(m.line + 1) : source;
+}
+
+std::string yaml_text(const YAML::Node& n) {
+  if (n.IsScalar()) return "\"" + n.Scalar() + "\"";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a mapping";
+  return "null";
+}
+
+bool plain(const YAML::Node& n) { return n.Tag() == "?"; }  // unquoted scalar
+
+std::optional<std::int64_t> as_int(const YAML::Node& n) {
+  if (!n.IsScalar() || !plain(n)) return std::nullopt;
+  const std::string& s = n.Scalar();
+  std::int64_t v = 0;
+  const auto* b = s.data();
+  const auto* e = s.data() + s.size();
+  if (b != e && *b == '+') ++b;
+  const auto res = std::from_chars(b, e, v);
+  if (res.ec != std::errc() || res.ptr != e || b == e) return std::nullopt;
+  return v;
+}
+
+std::optional<double> as_float(const YAML::Node& n) {
+  if (!n.IsScalar() || !plain(n)) return std::nullopt;
+  const std::string& s = n.Scalar();
+  double v = 0.0;
+  const auto res = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (res.ec != std::errc() || res.ptr != s.data() + s.size() || s.empty() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+// YAML → JSON for method parameters (core schema: null, bool, int, float, string, lists, maps)
+json to_json_value(const YAML::Node& n, const std::string& source, const std::string& field) {
+  if (!n || n.IsNull()) return nullptr;
+  if (n.IsSequence()) {
+    json a = json::array();
+    for (std::size_t i = 0; i < n.size(); ++i)
+      a.push_back(to_json_value(n[i], source, field + "[" + std::to_string(i) + "]"));
+    return a;
+  }
+  if (n.IsMap()) {
+    json o = json::object();
+    for (const auto& kv : n) {
+      const std::string key = kv.first.Scalar();
+      o[key] = to_json_value(kv.second, source, field + "." + key);
+    }
+    return o;
+  }
+  const std::string& s = n.Scalar();
+  if (plain(n)) {
+    if (s == "true" || s == "True" || s == "TRUE") return true;
+    if (s == "false" || s == "False" || s == "FALSE") return false;
+    if (s == "null" || s == "Null" || s == "NULL" || s == "~") return nullptr;
+    if (auto i = as_int(n)) return *i;
+    if (auto f = as_float(n)) return *f;
+    if (s == ".nan" || s == ".inf" || s == "-.inf" || s == ".NaN" || s == ".Inf")
+      throw InputError(at_line(source, n), field, "non-finite numbers are not allowed");
+  }
+  return s;
+}
+
+std::string require_string(const YAML::Node& n, const std::string& source, const std::string& field) {
+  if (!n.IsScalar() || n.Scalar().empty()) throw InputError(at_line(source, n), field, "expected a non-empty string (got " + yaml_text(n) + ")");
+  return n.Scalar();
+}
+
+std::string require_token(const YAML::Node& n, const std::string& source, const std::string& field) {
+  std::string s = require_string(n, source, field);
+  if (!detail::is_token(s)) throw InputError(at_line(source, n), field, "expected a name of [a-z0-9_.-] (got \"" + s + "\")");
+  return s;
+}
+
+std::vector<std::string> require_token_list(const YAML::Node& n, const std::string& source, const std::string& field) {
+  if (!n.IsSequence() || n.size() == 0) throw InputError(at_line(source, n), field, "expected a non-empty list of names");
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string f = field + "[" + std::to_string(i) + "]";
+    std::string s = require_token(n[i], source, f);
+    if (!seen.insert(s).second) throw InputError(at_line(source, n[i]), f, "duplicate entry \"" + s + "\"");
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+void check_json_keys(const json& j, const std::set<std::string>& keys, const std::string& src, const std::string& field) {
+  if (!j.is_object()) throw InputError(src, field, "expected an object");
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!keys.count(it.key())) throw InputError(src, field.empty() ? it.key() : field + "." + it.key(), "unknown field");
+  for (const auto& k : keys)
+    if (!j.contains(k)) throw InputError(src, field.empty() ? k : field + "." + k, "missing field");
+}
+
+}  // namespace
+
+Experiment parse_experiment(std::string_view text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::Exception& e) {
+    const std::string where = e.mark.line >= 0 ? source + ":" + std::to_string(e.mark.line + 1) : source;
+    throw InputError(where, "", "malformed YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
+  static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
+                                               "seeds",    "episodes",    "backbone", "pool",   "rotation_mode"};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
+    if (!known.count(key))
+      throw InputError(at_line(source, kv.first), key,
+                       "unknown key (expected one of name, description, tasks, splits, methods, seeds, episodes, "
+                       "backbone, pool, rotation_mode)");
+  }
+  for (const char* key : {"name", "tasks", "splits", "methods", "seeds", "episodes", "backbone"})
+    if (!root[key]) throw InputError(source, key, "missing required key");
+
+  Experiment ex;
+  ex.source = source;
+  ex.source_sha256 = sha256_hex(text);
+  ex.name = require_token(root["name"], source, "name");
+  if (root["description"]) ex.description = require_string(root["description"], source, "description");
+  ex.tasks = require_token_list(root["tasks"], source, "tasks");
+  ex.splits = require_token_list(root["splits"], source, "splits");
+
+  const YAML::Node methods = root["methods"];
+  if (!methods.IsSequence() || methods.size() == 0)
+    throw InputError(at_line(source, methods), "methods", "expected a non-empty list of methods");
+  std::set<std::string> seen_methods;
+  for (std::size_t i = 0; i < methods.size(); ++i) {
+    const std::string f = "methods[" + std::to_string(i) + "]";
+    const YAML::Node m = methods[i];
+    MethodEntry entry;
+    if (m.IsScalar()) {
+      entry.name = require_token(m, source, f);
+    } else if (m.IsMap()) {
+      for (const auto& kv : m) {
+        const std::string key = kv.first.Scalar();
+        if (key != "name" && key != "params")
+          throw InputError(at_line(source, kv.first), f + "." + key, "unknown key (expected name, params)");
+      }
+      if (!m["name"]) throw InputError(at_line(source, m), f + ".name", "missing required key");
+      entry.name = require_token(m["name"], source, f + ".name");
+      if (m["params"] && !m["params"].IsNull()) {
+        if (!m["params"].IsMap()) throw InputError(at_line(source, m["params"]), f + ".params", "expected a mapping");
+        entry.params = canonical_dump(to_json_value(m["params"], source, f + ".params"));
+      }
+    } else {
+      throw InputError(at_line(source, m), f, "expected a method name or {name, params}");
+    }
+    // two entries of one method must differ in parameters, or they are the same jobs
+    if (!seen_methods.insert(entry.name + entry.params).second)
+      throw InputError(at_line(source, m), f, "duplicate method \"" + entry.name + "\"");
+    ex.methods.push_back(std::move(entry));
+  }
+
+  const YAML::Node seeds = root["seeds"];
+  if (!seeds.IsSequence() || seeds.size() == 0) throw InputError(at_line(source, seeds), "seeds", "expected a non-empty list of integers");
+  std::set<std::uint64_t> seen_seeds;
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    const std::string f = "seeds[" + std::to_string(i) + "]";
+    const auto v = as_int(seeds[i]);
+    if (!v || *v < 0) throw InputError(at_line(source, seeds[i]), f, "expected a non-negative integer (got " + yaml_text(seeds[i]) + ")");
+    if (!seen_seeds.insert(static_cast<std::uint64_t>(*v)).second)
+      throw InputError(at_line(source, seeds[i]), f, "duplicate seed " + std::to_string(*v));
+    ex.seeds.push_back(static_cast<std::uint64_t>(*v));
+  }
+  const auto episodes = as_int(root["episodes"]);
+  if (!episodes || *episodes <= 0)
+    throw InputError(at_line(source, root["episodes"]), "episodes", "expected a positive integer (got " + yaml_text(root["episodes"]) + ")");
+  ex.episodes = *episodes;
+  ex.backbone = require_string(root["backbone"], source, "backbone");
+  if (root["pool"] && !root["pool"].IsNull()) ex.pool = require_token(root["pool"], source, "pool");
+  if (root["rotation_mode"]) {
+    ex.rotation_mode = require_string(root["rotation_mode"], source, "rotation_mode");
+    if (ex.rotation_mode != "live" && ex.rotation_mode != "identity")
+      throw InputError(at_line(source, root["rotation_mode"]), "rotation_mode",
+                       "expected \"live\" or \"identity\" (got \"" + ex.rotation_mode + "\")");
+  }
+  return ex;
+}
+
+Experiment load_experiment(const std::string& path) { return parse_experiment(detail::read_file(path), path); }
+
+Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
+  if (!resolver.split || !resolver.backbone) throw std::invalid_argument("make_plan: resolver needs split and backbone");
+  if (ex.pool && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");
+  Plan plan;
+  plan.experiment = ex.name;
+  plan.source = ex.source;
+  plan.source_sha256 = ex.source_sha256;
+  std::optional<PoolRef> pool;
+  if (ex.pool) pool = resolver.pool(*ex.pool);
+  if (resolver.check_method)
+    for (const auto& m : ex.methods) resolver.check_method(m);
+  std::set<std::string> ids;
+  for (const auto& task : ex.tasks) {
+    const BackboneRef backbone = resolver.backbone(task, ex.backbone);
+    for (const auto& split_name : ex.splits) {
+      const SplitRef split = resolver.split(task, split_name);
+      for (const auto& method : ex.methods) {
+        const std::optional<std::string> calibration =
+            resolver.calibration ? resolver.calibration(task, method) : std::nullopt;
+        for (const auto seed : ex.seeds) {
+          PlannedJob pj;
+          pj.index = static_cast<std::int64_t>(plan.jobs.size());
+          pj.spec.task = task;
+          pj.spec.split = split;
+          pj.spec.method = method.name;
+          pj.spec.method_params = method.params;
+          pj.spec.backbone = backbone;
+          pj.spec.pool = pool;
+          pj.spec.calibration_sha256 = calibration;
+          pj.spec.rotation_mode = ex.rotation_mode;
+          pj.spec.seed = seed;
+          pj.spec.episodes = ex.episodes;
+          validate_job(pj.spec, ex.source);
+          pj.job_id = job_id(pj.spec);
+          if (!ids.insert(pj.job_id).second)
+            throw InputError(ex.source, "", "two plan entries resolve to the same job " + pj.job_id);
+          plan.jobs.push_back(std::move(pj));
+        }
+      }
+    }
+  }
+  return plan;
+}
+
+nlohmann::json plan_to_json(const Plan& plan) {
+  json j = json::object();
+  j["schema_version"] = "1.0";
+  j["experiment"] = plan.experiment;
+  j["source"] = plan.source;
+  j["source_sha256"] = plan.source_sha256;
+  j["job_count"] = plan.jobs.size();
+  j["jobs"] = json::array();
+  for (const auto& pj : plan.jobs)
+    j["jobs"].push_back({{"index", pj.index}, {"job_id", pj.job_id}, {"spec", job_to_json(pj.spec)}});
+  return j;
+}
+
+Plan plan_from_json(const nlohmann::json& j, const std::string& source) {
+  check_json_keys(j, {"schema_version", "experiment", "source", "source_sha256", "job_count", "jobs"}, source, "");
+  if (j.at("schema_version") != "1.0") throw InputError(source, "schema_version", "unsupported plan schema version");
+  Plan plan;
+  if (!j.at("experiment").is_string() || !j.at("source").is_string() || !j.at("source_sha256").is_string())
+    throw InputError(source, "experiment", "experiment, source and source_sha256 must be strings");
+  plan.experiment = j.at("experiment").get<std::string>();
+  plan.source = j.at("source").get<std::string>();
+  plan.source_sha256 = j.at("source_sha256").get<std::string>();
+  const json& jobs = j.at("jobs");
+  if (!jobs.is_array()) throw InputError(source, "jobs", "expected a list");
+  if (!j.at("job_count").is_number_integer() || j.at("job_count").get<std::int64_t>() != static_cast<std::int64_t>(jobs.size()))
+    throw InputError(source, "job_count", "does not match the number of jobs (" + std::to_string(jobs.size()) + ")");
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const std::string f = "jobs[" + std::to_string(i) + "]";
+    check_json_keys(jobs[i], {"index", "job_id", "spec"}, source, f);
+    PlannedJob pj;
+    const json& index = jobs[i].at("index");
+    if (!index.is_number_integer() || index.get<std::int64_t>() != static_cast<std::int64_t>(i))
+      throw InputError(source, f + ".index", "expected " + std::to_string(i));
+    pj.index = static_cast<std::int64_t>(i);
+    pj.spec = job_from_json(jobs[i].at("spec"), source + ": " + f + ".spec");
+    pj.job_id = job_id(pj.spec);
+    if (jobs[i].at("job_id") != pj.job_id)
+      throw InputError(source, f + ".job_id", "does not match the hash of its spec (expected " + pj.job_id + ")");
+    plan.jobs.push_back(std::move(pj));
+  }
+  return plan;
+}
+
+Plan load_plan(const std::string& path) {
+  const std::string text = detail::read_file(path);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error&) {
+    throw InputError(path, "", "malformed JSON plan file");
+  }
+  return plan_from_json(j, path);
+}
+
+void write_plan(const std::string& path, const Plan& plan) { write_json_atomic(path, plan_to_json(plan)); }
+
+std::string shell_quote(std::string_view s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') out += "'\\''";
+    else out.push_back(c);
+  }
+  out += "'";
+  return out;
+}
+
+std::string slurm_array_script(const Plan& plan, const SlurmOptions& o) {
+  if (plan.jobs.empty()) throw std::invalid_argument("slurm_array_script: the plan has no jobs");
+  if (o.plan_path.empty()) throw std::invalid_argument("slurm_array_script: plan_path is required");
+  const unsigned cpus = o.cpus_per_task ? o.cpus_per_task : 1;
+  std::ostringstream s;
+  s << "#!/bin/bash\n"
+    << "# Slurm job array for experiment '" << plan.experiment << "' (" << plan.jobs.size() << " jobs).\n"
+    << "# Array task i runs job i of the plan; re-submitting is safe: finished jobs are no-ops and\n"
+    << "# killed or pre-empted jobs resume from their last complete record.\n"
+    << "# Submit: sbatch <this file>    Merge afterwards: actionshift summarize " << shell_quote(o.out_dir) << "\n"
+    << "#SBATCH --job-name=actionshift-" << plan.experiment << "\n"
+    << "#SBATCH --array=0-" << plan.jobs.size() - 1;
+  if (o.max_parallel) s << "%" << o.max_parallel;
+  s << "\n"
+    << "#SBATCH --cpus-per-task=" << cpus << "\n"
+    << "#SBATCH --time=" << o.time_limit << "\n";
+  if (!o.partition.empty()) s << "#SBATCH --partition=" << o.partition << "\n";
+  s << "#SBATCH --output=" << o.out_dir << "/slurm-%A_%a.log\n"
+    << "#SBATCH --requeue\n"
+    << "set -euo pipefail\n"
+    << "exec " << shell_quote(o.executable) << " run --plan " << shell_quote(o.plan_path)
+    << " --job-index \"${SLURM_ARRAY_TASK_ID}\" --out " << shell_quote(o.out_dir) << " --threads \"${SLURM_CPUS_PER_TASK:-"
+    << cpus << "}\"\n";
+  return s.str();
+}
+
+}  // namespace actionshift::eval

@@ -1,0 +1,223 @@
+#include "actionshift/eval/runner.hpp"
+
+#include "actionshift/eval/store.hpp"
+#include "io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace actionshift::eval {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// progress display: a self-overwriting bar on a terminal, periodic log lines otherwise
+class Progress {
+ public:
+  Progress(ProgressMode mode, std::ostream& out, std::string id, std::int64_t before, std::int64_t total)
+      : out_(out), id_(std::move(id)), before_(before), total_(total), t0_(Clock::now()), last_(t0_) {
+    if (mode == ProgressMode::automatic) mode = ::isatty(STDERR_FILENO) ? ProgressMode::bar : ProgressMode::lines;
+    mode_ = mode;
+  }
+
+  void update(std::int64_t done) {
+    if (mode_ == ProgressMode::off) return;
+    const auto now = Clock::now();
+    const double since_last = std::chrono::duration<double>(now - last_).count();
+    if (since_last < (mode_ == ProgressMode::bar ? 0.1 : 5.0)) return;
+    last_ = now;
+    show(done, false);
+  }
+
+  void finish(std::int64_t done) {
+    if (mode_ == ProgressMode::off) return;
+    show(done, true);
+  }
+
+ private:
+  void show(std::int64_t done, bool final) {
+    const double elapsed = seconds_since(t0_);
+    const double rate = elapsed > 0.0 ? static_cast<double>(done - before_) / elapsed : 0.0;
+    const double eta = rate > 0.0 ? static_cast<double>(total_ - done) / rate : -1.0;
+    char head[160];
+    std::snprintf(head, sizeof head, "%lld/%lld episodes  %.1f episodes/s  ", static_cast<long long>(done),
+                  static_cast<long long>(total_), rate);
+    const std::string short_id = id_.substr(0, 12);
+    if (mode_ == ProgressMode::bar) {
+      constexpr int kWidth = 24;
+      const int filled = total_ > 0 ? static_cast<int>(kWidth * done / total_) : kWidth;
+      std::string bar(static_cast<std::size_t>(filled), '#');
+      bar.resize(kWidth, '.');
+      out_ << "\r" << short_id << " [" << bar << "] " << head
+           << (final ? "done in " + detail::format_seconds(elapsed) : "ETA " + detail::format_seconds(eta)) << "   ";
+      if (final) out_ << "\n";
+      out_.flush();
+    } else {
+      out_ << "actionshift: job " << short_id << ": " << head
+           << (final ? "done in " + detail::format_seconds(elapsed) : "ETA " + detail::format_seconds(eta)) << "\n";
+      out_.flush();
+    }
+  }
+
+  std::ostream& out_;
+  ProgressMode mode_{ProgressMode::off};
+  std::string id_;
+  std::int64_t before_, total_;
+  Clock::time_point t0_, last_;
+};
+
+}  // namespace
+
+RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& options) {
+  const auto t0 = Clock::now();
+  std::ostream& log = options.log ? *options.log : std::cerr;
+  ResultStore store = ResultStore::open(options.out_dir, job, StoreOptions{options.fsync, &log});
+
+  RunResult result;
+  result.job_id = store.job_id();
+  result.jsonl_path = store.jsonl_path();
+  result.summary_path = store.summary_path();
+  result.episodes_total = job.episodes;
+  result.episodes_before = store.episodes_done();
+
+  // a finished job is a no-op; only a missing summary (killed before writing it) is restored
+  if (store.complete()) {
+    result.already_complete = true;
+    if (!std::filesystem::exists(store.summary_path()))
+      write_json_atomic(store.summary_path(),
+                        make_job_summary(job, store.records(), 0, seconds_since(t0),
+                                         "complete: " + std::to_string(job.episodes) + " episodes (summary restored)"));
+    result.wall_time_s = seconds_since(t0);
+    return result;
+  }
+
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::int64_t first = store.episodes_done();
+  const std::int64_t remaining = job.episodes - first;
+  threads = static_cast<unsigned>(std::min<std::int64_t>(threads, remaining));
+  // workers may run at most `window` episodes ahead of the writer (bounds the reorder buffer)
+  const std::int64_t window = std::max<std::int64_t>(64, 8 * static_cast<std::int64_t>(threads));
+
+  std::mutex mu;
+  std::condition_variable cv;
+  std::map<std::int64_t, EpisodeRecord> ready;  // reorder buffer: finished, not yet written
+  std::int64_t written = first;                 // next index to write (guarded by mu)
+  std::int64_t failed_at = -1;                  // lowest failing episode (guarded by mu)
+  std::exception_ptr failure;
+  std::atomic<std::int64_t> next{first};
+
+  auto worker = [&](unsigned w) {
+    for (;;) {
+      const std::int64_t i = next.fetch_add(1);
+      if (i >= job.episodes) return;
+      {
+        std::unique_lock lock(mu);
+        cv.wait(lock, [&] { return i < written + window || failure; });
+        if (failure && i > failed_at) return;
+      }
+      const auto slot = episode_slot(job.split.contracts, i);
+      EpisodeTask task{&job, job.seed, slot.contract_index, slot.contract_episode, i,
+                       episode_seed(job.seed, slot.contract_index, i), w};
+      try {
+        EpisodeRecord r = fn(task);
+        // stamp the job fields; the episode function owns only the outcome and contract hash
+        r.schema_version = std::string(kRecordSchemaVersion);
+        r.job_id = store.job_id();
+        r.task = job.task;
+        r.split = job.split.name;
+        r.method = job.method;
+        r.seed = job.seed;
+        r.contract_index = slot.contract_index;
+        r.episode_index = i;
+        r.backbone = job.backbone.name;
+        r.backbone_sha256 = job.backbone.sha256;
+        validate_record(r, "episode " + std::to_string(i));
+        std::lock_guard lock(mu);
+        ready.emplace(i, std::move(r));
+      } catch (...) {
+        std::lock_guard lock(mu);
+        if (!failure || i < failed_at) {
+          failure = std::current_exception();
+          failed_at = i;
+        }
+      }
+      cv.notify_all();
+    }
+  };
+
+  std::vector<std::thread> pool;
+  pool.reserve(threads);
+  for (unsigned w = 0; w < threads; ++w) pool.emplace_back(worker, w);
+
+  Progress progress(options.progress, log, store.job_id(), first, job.episodes);
+  std::exception_ptr write_failure;
+  {
+    std::unique_lock lock(mu);
+    while (written < job.episodes) {
+      cv.wait(lock, [&] { return ready.count(written) || (failure && written >= failed_at); });
+      if (!ready.count(written)) break;  // the next episode failed: stop at the last contiguous record
+      EpisodeRecord r = std::move(ready.at(written));
+      ready.erase(written);
+      lock.unlock();
+      try {
+        store.append(r);
+      } catch (...) {
+        write_failure = std::current_exception();
+      }
+      lock.lock();
+      if (write_failure) {
+        if (!failure || written < failed_at) {
+          failure = write_failure;
+          failed_at = written;
+        }
+        cv.notify_all();
+        break;
+      }
+      ++written;
+      cv.notify_all();
+      lock.unlock();
+      progress.update(store.episodes_done());
+      lock.lock();
+    }
+  }
+  for (auto& t : pool) t.join();
+
+  result.episodes_run = store.episodes_done() - first;
+  result.wall_time_s = seconds_since(t0);
+  std::string message;
+  if (failure) {
+    message = "stopped at episode " + std::to_string(failed_at) + " of " + std::to_string(job.episodes) +
+              "; re-run to resume";
+  } else {
+    message = "complete: " + std::to_string(job.episodes) + " episodes" +
+              (first > 0 ? " (resumed after " + std::to_string(first) + ")" : "");
+  }
+  write_json_atomic(store.summary_path(),
+                    make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
+  if (failure) {
+    if (options.progress != ProgressMode::off) log << "\n";
+    std::rethrow_exception(failure);
+  }
+  progress.finish(store.episodes_done());
+  return result;
+}
+
+}  // namespace actionshift::eval

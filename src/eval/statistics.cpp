@@ -1,0 +1,139 @@
+#include "actionshift/eval/statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace actionshift::eval {
+
+WilsonInterval wilson_interval(std::int64_t successes, std::int64_t total, double z, double confidence) {
+  if (total <= 0)
+    throw std::invalid_argument("wilson_interval: at least one trial is required (got total " +
+                                std::to_string(total) + ")");
+  if (successes < 0 || successes > total)
+    throw std::invalid_argument("wilson_interval: successes must be in [0, total] (got " +
+                                std::to_string(successes) + " of " + std::to_string(total) + ")");
+  if (!(confidence > 0.0 && confidence < 1.0))
+    throw std::invalid_argument("wilson_interval: confidence must be in (0, 1)");
+  // same operation order as the reference's Python, so results agree to the last bit
+  const double n = static_cast<double>(total);
+  const double p = static_cast<double>(successes) / n;
+  const double z2 = z * z;
+  const double denominator = 1.0 + z2 / n;
+  const double centre = (p + z2 / (2.0 * n)) / denominator;
+  const double half = z * std::sqrt(p * (1.0 - p) / n + z2 / (4.0 * n * n)) / denominator;
+  WilsonInterval w;
+  w.successes = successes;
+  w.total = total;
+  w.rate = p;
+  w.lower = centre - half;
+  w.upper = centre + half;
+  w.confidence = confidence;
+  return w;
+}
+
+std::uint64_t BoundedRng::below(std::uint64_t n) {
+  if (n == 0) throw std::invalid_argument("BoundedRng::below: n must be positive");
+  // reject the top (2^64 mod n) values so every residue is equally likely
+  const std::uint64_t excess = (std::numeric_limits<std::uint64_t>::max() % n + 1) % n;
+  const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() - excess;  // inclusive
+  for (;;) {
+    const std::uint64_t x = engine_();
+    if (x <= limit) return x % n;
+  }
+}
+
+double linear_quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) throw std::invalid_argument("linear_quantile: empty sample");
+  if (!(q >= 0.0 && q <= 1.0)) throw std::invalid_argument("linear_quantile: q must be in [0, 1]");
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const double below = std::floor(pos);
+  const auto lo = static_cast<std::size_t>(below);
+  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  const double t = pos - below;
+  const double a = sorted[lo];
+  const double b = sorted[hi];
+  // numpy's _lerp: a + (b−a)·t, computed from the upper end when t ≥ 0.5 (exact at t = 1)
+  const double diff = b - a;
+  return t >= 0.5 ? b - diff * (1.0 - t) : a + diff * t;
+}
+
+namespace {
+
+void check_bootstrap_args(double confidence, std::size_t samples) {
+  if (!(confidence > 0.0 && confidence < 1.0))
+    throw std::invalid_argument("bootstrap: confidence must be in (0, 1)");
+  if (samples == 0) throw std::invalid_argument("bootstrap: samples must be positive");
+}
+
+// resampled means of `values`, sorted; integer-valued inputs keep exact sums
+BootstrapInterval percentile_bootstrap(const std::vector<double>& values, double confidence,
+                                       std::size_t samples, std::uint64_t seed) {
+  const std::size_t n = values.size();
+  BoundedRng rng(seed);
+  std::vector<double> means(samples);
+  for (std::size_t s = 0; s < samples; ++s) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < n; ++k) sum += values[rng.below(n)];
+    means[s] = sum / static_cast<double>(n);
+  }
+  std::sort(means.begin(), means.end());
+  double total = 0.0;
+  for (double v : values) total += v;
+  BootstrapInterval out;
+  out.estimate = total / static_cast<double>(n);
+  const double alpha = (1.0 - confidence) / 2.0;
+  out.lower = linear_quantile(means, alpha);
+  out.upper = linear_quantile(means, 1.0 - alpha);
+  out.confidence = confidence;
+  out.samples = samples;
+  out.pairs = n;
+  out.seed = seed;
+  return out;
+}
+
+}  // namespace
+
+BootstrapInterval bootstrap_interval(const std::vector<double>& values, double confidence,
+                                     std::size_t samples, std::uint64_t seed) {
+  check_bootstrap_args(confidence, samples);
+  if (values.empty()) throw std::invalid_argument("bootstrap_interval: values must not be empty");
+  for (double v : values)
+    if (!std::isfinite(v)) throw std::invalid_argument("bootstrap_interval: values must be finite");
+  return percentile_bootstrap(values, confidence, samples, seed);
+}
+
+BootstrapInterval paired_success_difference(const std::vector<bool>& candidate,
+                                            const std::vector<bool>& baseline, double confidence,
+                                            std::size_t samples, std::uint64_t seed) {
+  check_bootstrap_args(confidence, samples);
+  if (candidate.size() != baseline.size())
+    throw std::invalid_argument("paired inputs must contain the same number of episodes (candidate " +
+                                std::to_string(candidate.size()) + ", baseline " +
+                                std::to_string(baseline.size()) + ")");
+  if (candidate.empty()) throw std::invalid_argument("paired inputs must contain at least one episode");
+  std::vector<double> d(candidate.size());
+  for (std::size_t k = 0; k < d.size(); ++k)
+    d[k] = static_cast<double>(static_cast<int>(candidate[k]) - static_cast<int>(baseline[k]));
+  return percentile_bootstrap(d, confidence, samples, seed);
+}
+
+TwoProportionSummary two_proportion_summary(std::int64_t successes_a, std::int64_t total_a,
+                                            std::int64_t successes_b, std::int64_t total_b, double z) {
+  TwoProportionSummary out;
+  out.a = wilson_interval(successes_a, total_a, z);
+  out.b = wilson_interval(successes_b, total_b, z);
+  out.difference = out.a.rate - out.b.rate;
+  out.absolute_difference = std::fabs(out.difference);
+  // Newcombe (1998) method 10: combine the two Wilson intervals
+  const double da_lo = out.a.rate - out.a.lower, da_hi = out.a.upper - out.a.rate;
+  const double db_lo = out.b.rate - out.b.lower, db_hi = out.b.upper - out.b.rate;
+  out.lower = out.difference - std::sqrt(da_lo * da_lo + db_hi * db_hi);
+  out.upper = out.difference + std::sqrt(da_hi * da_hi + db_lo * db_lo);
+  out.intervals_overlap = std::max(out.a.lower, out.b.lower) <= std::min(out.a.upper, out.b.upper);
+  return out;
+}
+
+}  // namespace actionshift::eval

@@ -1,0 +1,254 @@
+#include "actionshift/eval/store.hpp"
+
+#include "actionshift/core/error.hpp"
+#include "actionshift/eval/statistics.hpp"
+#include "io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <ostream>
+#include <stdexcept>
+
+namespace actionshift::eval {
+
+namespace {
+
+using nlohmann::json;
+
+std::string errno_text() { return std::strerror(errno); }
+
+std::string read_fd(int fd, const std::string& path) {
+  std::string out;
+  char buf[1 << 16];
+  off_t off = 0;
+  for (;;) {
+    const ssize_t n = ::pread(fd, buf, sizeof buf, off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw InputError(path, "", "read failed: " + errno_text());
+    if (n == 0) break;
+    out.append(buf, static_cast<std::size_t>(n));
+    off += n;
+  }
+  return out;
+}
+
+}  // namespace
+
+void check_record_belongs(const EpisodeRecord& r, const JobSpec& job, const std::string& id,
+                          std::int64_t episode_index, const std::string& src) {
+  auto differs = [&](const char* field, const std::string& got, const std::string& want) {
+    throw InputError(src, field, "record belongs to another job (got \"" + got + "\", expected \"" + want + "\")");
+  };
+  if (r.job_id != id) differs("job_id", r.job_id, id);
+  if (r.episode_index != episode_index)
+    throw InputError(src, "episode_index", "records must be episodes 0..k-1 in order (got " +
+                                               std::to_string(r.episode_index) + ", expected " +
+                                               std::to_string(episode_index) + ")");
+  if (r.task != job.task) differs("task", r.task, job.task);
+  if (r.split != job.split.name) differs("split", r.split, job.split.name);
+  if (r.method != job.method) differs("method", r.method, job.method);
+  if (r.seed != job.seed) differs("seed", std::to_string(r.seed), std::to_string(job.seed));
+  if (r.backbone != job.backbone.name) differs("backbone", r.backbone, job.backbone.name);
+  if (r.backbone_sha256 != job.backbone.sha256) differs("backbone_sha256", r.backbone_sha256, job.backbone.sha256);
+  const auto slot = episode_slot(job.split.contracts, episode_index);
+  if (r.contract_index != slot.contract_index)
+    throw InputError(src, "contract_index", "expected " + std::to_string(slot.contract_index) + " for episode " +
+                                                std::to_string(episode_index) + " (got " +
+                                                std::to_string(r.contract_index) + ")");
+}
+
+ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, const StoreOptions& options) {
+  ResultStore s;
+  s.job_ = job;
+  s.id_ = eval::job_id(job);  // validates the job
+  s.fsync_ = options.fsync;
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) throw InputError(out_dir, "", "cannot create output directory: " + ec.message());
+  s.path_ = (std::filesystem::path(out_dir) / jsonl_file_name(s.id_)).string();
+  s.summary_path_ = (std::filesystem::path(out_dir) / summary_file_name(s.id_)).string();
+
+  // open without truncation and take the job's lock before reading anything
+  s.fd_ = ::open(s.path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (s.fd_ < 0) throw InputError(s.path_, "", "cannot open results file: " + errno_text());
+  if (::flock(s.fd_, LOCK_EX | LOCK_NB) != 0)
+    throw InputError(s.path_, "", "another process is running this job (results file is locked)");
+
+  const std::string bytes = read_fd(s.fd_, s.path_);
+  // split into lines; the last piece is torn if it has no newline
+  std::vector<std::pair<std::size_t, std::size_t>> lines;  // [begin, end) without the newline
+  std::size_t start = 0;
+  bool unterminated = false;
+  while (start < bytes.size()) {
+    const std::size_t nl = bytes.find('\n', start);
+    if (nl == std::string::npos) {
+      lines.emplace_back(start, bytes.size());
+      unterminated = true;
+      break;
+    }
+    lines.emplace_back(start, nl);
+    start = nl + 1;
+  }
+
+  // validate everything first; only a torn tail may be repaired, and only after all else passed
+  std::size_t keep_bytes = bytes.size();
+  std::vector<EpisodeRecord> records;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const bool last = i + 1 == lines.size();
+    const std::string src = s.path_ + ":" + std::to_string(i + 1);
+    const std::string_view text = std::string_view(bytes).substr(lines[i].first, lines[i].second - lines[i].first);
+    if (last && unterminated) {
+      keep_bytes = lines[i].first;
+      break;
+    }
+    EpisodeRecord r;
+    try {
+      r = parse_record_line(text, src);
+    } catch (const InputError&) {
+      if (!last) throw;
+      keep_bytes = lines[i].first;  // a complete but unparsable last line is a torn write too
+      break;
+    }
+    check_record_belongs(r, job, s.id_, static_cast<std::int64_t>(i), src);
+    if (static_cast<std::int64_t>(i) >= job.episodes)
+      throw InputError(src, "episode_index", "more records than the job's " + std::to_string(job.episodes) + " episodes");
+    records.push_back(std::move(r));
+  }
+  if (keep_bytes < bytes.size()) {
+    if (::ftruncate(s.fd_, static_cast<off_t>(keep_bytes)) != 0)
+      throw InputError(s.path_, "", "cannot truncate torn last line: " + errno_text());
+    s.repaired_bytes_ = static_cast<std::int64_t>(bytes.size() - keep_bytes);
+    if (options.log)
+      *options.log << "actionshift: " << s.path_ << ": repaired a torn last line (" << s.repaired_bytes_
+                   << " bytes removed after record " << records.size() << ")\n";
+  }
+  s.records_ = std::move(records);
+  return s;
+}
+
+ResultStore::ResultStore(ResultStore&& o) noexcept
+    : job_(std::move(o.job_)),
+      id_(std::move(o.id_)),
+      path_(std::move(o.path_)),
+      summary_path_(std::move(o.summary_path_)),
+      records_(std::move(o.records_)),
+      repaired_bytes_(o.repaired_bytes_),
+      fsync_(o.fsync_),
+      fd_(o.fd_) {
+  o.fd_ = -1;
+}
+
+ResultStore& ResultStore::operator=(ResultStore&& o) noexcept {
+  if (this != &o) {
+    if (fd_ >= 0) ::close(fd_);
+    job_ = std::move(o.job_);
+    id_ = std::move(o.id_);
+    path_ = std::move(o.path_);
+    summary_path_ = std::move(o.summary_path_);
+    records_ = std::move(o.records_);
+    repaired_bytes_ = o.repaired_bytes_;
+    fsync_ = o.fsync_;
+    fd_ = o.fd_;
+    o.fd_ = -1;
+  }
+  return *this;
+}
+
+ResultStore::~ResultStore() {
+  if (fd_ >= 0) ::close(fd_);  // also releases the flock
+}
+
+void ResultStore::append(const EpisodeRecord& record) {
+  if (fd_ < 0) throw std::runtime_error("ResultStore::append: store is closed");
+  if (complete()) throw std::invalid_argument("ResultStore::append: job already has all its episodes");
+  check_record_belongs(record, job_, id_, episodes_done(), "ResultStore::append");
+  const std::string line = to_jsonl_line(record) + "\n";
+  // one write(2) of the whole line: a kill leaves the line whole or absent (or torn on disk-full,
+  // which the next open repairs)
+  std::size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw std::runtime_error(path_ + ": write failed: " + errno_text());
+    done += static_cast<std::size_t>(n);
+  }
+  if (fsync_ && ::fsync(fd_) != 0) throw std::runtime_error(path_ + ": fsync failed: " + errno_text());
+  records_.push_back(record);
+}
+
+nlohmann::json make_job_summary(const JobSpec& job, const std::vector<EpisodeRecord>& records,
+                                std::int64_t episodes_run, double wall_time_s, const std::string& message) {
+  json s = json::object();
+  const auto n = static_cast<std::int64_t>(records.size());
+  s["schema_version"] = "1.0";
+  s["job_id"] = job_id(job);
+  s["job"] = job_to_json(job);
+  s["episodes_requested"] = job.episodes;
+  s["episodes_done"] = n;
+  s["complete"] = n >= job.episodes;
+  s["episodes_run"] = episodes_run;
+  s["wall_time_s"] = wall_time_s;
+  s["message"] = message;
+
+  std::int64_t once = 0, at_end = 0, flagged = 0, probe_steps = 0, steps = 0;
+  double ret = 0.0, disp = 0.0;
+  std::map<std::string, std::int64_t> flags;
+  struct PerContract {
+    std::string sha;
+    std::int64_t episodes{0}, successes{0};
+  };
+  std::map<std::int64_t, PerContract> per_contract;
+  for (const auto& r : records) {
+    once += r.success_once;
+    at_end += r.success_at_end;
+    ret += r.task_return;
+    steps += r.steps;
+    probe_steps += r.probe_steps;
+    disp += r.probe_displacement;
+    if (!r.safety_flags.empty()) ++flagged;
+    for (const auto& f : r.safety_flags) ++flags[f];
+    auto& pc = per_contract[r.contract_index];
+    pc.sha = r.contract_sha256;
+    ++pc.episodes;
+    pc.successes += r.success_once;
+  }
+  auto wilson_json = [&](std::int64_t k) -> json {
+    if (n == 0) return nullptr;
+    const auto w = wilson_interval(k, n);
+    return {{"successes", w.successes}, {"total", w.total}, {"rate", w.rate},
+            {"lower", w.lower},         {"upper", w.upper}, {"confidence", w.confidence}};
+  };
+  auto mean = [&](double total) -> json { return n == 0 ? json(nullptr) : json(total / static_cast<double>(n)); };
+  s["success_once"] = wilson_json(once);
+  s["success_at_end"] = wilson_json(at_end);
+  s["mean_return"] = mean(ret);
+  s["mean_steps"] = mean(static_cast<double>(steps));
+  s["mean_probe_steps"] = mean(static_cast<double>(probe_steps));
+  s["mean_probe_displacement"] = mean(disp);
+  s["episodes_with_safety_flags"] = flagged;
+  s["safety_flag_counts"] = json::object();
+  for (const auto& [name, count] : flags) s["safety_flag_counts"][name] = count;
+  s["per_contract"] = json::array();
+  for (const auto& [index, pc] : per_contract)
+    s["per_contract"].push_back({{"contract_index", index},
+                                 {"contract_sha256", pc.sha},
+                                 {"episodes", pc.episodes},
+                                 {"successes_once", pc.successes},
+                                 {"success_once_rate", static_cast<double>(pc.successes) / static_cast<double>(pc.episodes)}});
+  return s;
+}
+
+void write_json_atomic(const std::string& path, const nlohmann::json& value) {
+  detail::atomic_write(path, value.dump(2) + "\n");
+}
+
+}  // namespace actionshift::eval
