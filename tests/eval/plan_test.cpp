@@ -1,0 +1,161 @@
+#include "actionshift/eval/plan.hpp"
+
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <set>
+
+namespace actionshift::eval {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+PlanResolver fake_resolver() {
+  PlanResolver r;
+  r.split = [](const std::string& task, const std::string& split) {
+    if (split == "missing") throw InputError("manifests/" + split + ".json", "", "no such split manifest");
+    (void)task;
+    return SplitRef{split, sha256_hex("manifest:" + split), 2};
+  };
+  r.backbone = [](const std::string& task, const std::string& name) {
+    return BackboneRef{name, sha256_hex(name + ":" + task)};
+  };
+  r.pool = [](const std::string& name) { return PoolRef{name, sha256_hex("pool:" + name)}; };
+  r.check_method = [](const MethodEntry& m) {
+    if (m.name != "oracle" && m.name != "no_adapt" && m.name != "fixed_probes")
+      throw InputError("method", m.name, "unknown method");
+  };
+  return r;
+}
+
+const char* kYaml = R"(
+name: tiny
+description: two tasks
+tasks: [pick_cube, push_cube]
+splits: [seen, long_lag]
+methods:
+  - oracle
+  - name: fixed_probes
+    params: {budget: 6, amplitude: 0.5, label: "x", on: true}
+seeds: [1, 2, 3]
+episodes: 16
+backbone: expert
+)";
+
+TEST(Experiment, ParsesAllKeys) {
+  const Experiment ex = parse_experiment(kYaml, "tiny.yaml");
+  EXPECT_EQ(ex.name, "tiny");
+  EXPECT_EQ(ex.tasks, (std::vector<std::string>{"pick_cube", "push_cube"}));
+  EXPECT_EQ(ex.splits, (std::vector<std::string>{"seen", "long_lag"}));
+  ASSERT_EQ(ex.methods.size(), 2u);
+  EXPECT_EQ(ex.methods[0].params, "{}");
+  EXPECT_EQ(ex.methods[1].params, "{\"amplitude\":0.5,\"budget\":6,\"label\":\"x\",\"on\":true}");
+  EXPECT_EQ(ex.seeds, (std::vector<std::uint64_t>{1, 2, 3}));
+  EXPECT_EQ(ex.episodes, 16);
+  EXPECT_EQ(ex.rotation_mode, "live");
+  EXPECT_FALSE(ex.pool);
+  EXPECT_EQ(ex.source_sha256, sha256_hex(kYaml));
+}
+
+TEST(Experiment, ErrorsNameFileAndField) {
+  auto fails = [](const std::string& text, const std::string& needle) {
+    EXPECT_THAT([&] { parse_experiment(text, "e.yaml"); }, ThrowsMessage<InputError>(HasSubstr(needle))) << text;
+  };
+  const std::string base = "name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n";
+  EXPECT_NO_THROW(parse_experiment(base, "e.yaml"));
+  fails(base + "colour: red\n", "e.yaml:8: colour: unknown key");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nbackbone: expert\n",
+        "e.yaml: episodes: missing required key");
+  fails(base + "rotation_mode: real\n", "rotation_mode: expected \"live\" or \"identity\"");
+  fails("name: x\ntasks: [pick_cube, pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
+        "tasks[1]: duplicate entry");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1, -2]\nepisodes: 4\nbackbone: expert\n",
+        "seeds[1]: expected a non-negative integer");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: many\nbackbone: expert\n",
+        "episodes: expected a positive integer");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [{name: oracle, budget: 3}]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
+        "methods[0].budget: unknown key");
+  fails("name: x\ntasks: {a: 1}\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
+        "tasks: expected a non-empty list of names");
+  fails("name: [unclosed\n", "e.yaml:");
+  fails("name: [unclosed\n", "malformed YAML");
+  fails("- just\n- a list\n", "expected a mapping");
+  EXPECT_THAT([] { load_experiment("/nonexistent/e.yaml"); }, ThrowsMessage<InputError>(HasSubstr("/nonexistent/e.yaml: cannot open file")));
+}
+
+TEST(Plan, CartesianProductInStableOrder) {
+  const Plan plan = make_plan(parse_experiment(kYaml, "tiny.yaml"), fake_resolver());
+  ASSERT_EQ(plan.jobs.size(), 2u * 2u * 2u * 3u);
+  // tasks outermost, seeds innermost
+  EXPECT_EQ(plan.jobs[0].spec.task, "pick_cube");
+  EXPECT_EQ(plan.jobs[0].spec.split.name, "seen");
+  EXPECT_EQ(plan.jobs[0].spec.method, "oracle");
+  EXPECT_EQ(plan.jobs[0].spec.seed, 1u);
+  EXPECT_EQ(plan.jobs[1].spec.seed, 2u);
+  EXPECT_EQ(plan.jobs[3].spec.method, "fixed_probes");
+  EXPECT_EQ(plan.jobs[6].spec.split.name, "long_lag");
+  EXPECT_EQ(plan.jobs[12].spec.task, "push_cube");
+  EXPECT_EQ(plan.jobs[12].spec.backbone.sha256, sha256_hex("expert:push_cube"));
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < plan.jobs.size(); ++i) {
+    EXPECT_EQ(plan.jobs[i].index, static_cast<std::int64_t>(i));
+    EXPECT_EQ(plan.jobs[i].job_id, job_id(plan.jobs[i].spec));
+    ids.insert(plan.jobs[i].job_id);
+  }
+  EXPECT_EQ(ids.size(), plan.jobs.size());
+}
+
+TEST(Plan, ResolverErrorsPropagate) {
+  auto ex = parse_experiment(kYaml, "tiny.yaml");
+  ex.splits.push_back("missing");
+  EXPECT_THAT([&] { make_plan(ex, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("no such split manifest")));
+  ex = parse_experiment(kYaml, "tiny.yaml");
+  ex.methods.push_back({"telepathy", "{}"});
+  EXPECT_THAT([&] { make_plan(ex, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("telepathy: unknown method")));
+}
+
+TEST(Plan, FileRoundTripAndTamperDetection) {
+  const Plan plan = make_plan(parse_experiment(kYaml, "tiny.yaml"), fake_resolver());
+  const auto dir = std::filesystem::temp_directory_path() / "actionshift_plan_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "tiny.plan.json").string();
+  write_plan(path, plan);
+  const Plan back = load_plan(path);
+  ASSERT_EQ(back.jobs.size(), plan.jobs.size());
+  for (std::size_t i = 0; i < plan.jobs.size(); ++i) {
+    EXPECT_EQ(back.jobs[i].job_id, plan.jobs[i].job_id);
+    EXPECT_EQ(job_id(back.jobs[i].spec), plan.jobs[i].job_id);
+  }
+  nlohmann::json j = plan_to_json(plan);
+  j["jobs"][3]["spec"]["seed"] = 99;
+  EXPECT_THAT([&] { plan_from_json(j, "p.json"); },
+              ThrowsMessage<InputError>(HasSubstr("p.json: jobs[3].job_id: does not match the hash of its spec")));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Plan, SlurmArrayScript) {
+  const Plan plan = make_plan(parse_experiment(kYaml, "tiny.yaml"), fake_resolver());
+  SlurmOptions o;
+  o.plan_path = "/data/plans/tiny plan.json";
+  o.out_dir = "/data/results";
+  o.executable = "/opt/actionshift/bin/actionshift";
+  o.cpus_per_task = 4;
+  o.max_parallel = 8;
+  const std::string s = slurm_array_script(plan, o);
+  EXPECT_THAT(s, HasSubstr("#!/bin/bash\n"));
+  EXPECT_THAT(s, HasSubstr("#SBATCH --array=0-23%8\n"));
+  EXPECT_THAT(s, HasSubstr("#SBATCH --cpus-per-task=4\n"));
+  EXPECT_THAT(s, HasSubstr("'/opt/actionshift/bin/actionshift' run --plan '/data/plans/tiny plan.json' "
+                           "--job-index \"${SLURM_ARRAY_TASK_ID}\" --out '/data/results' --threads"));
+  EXPECT_EQ(s.find("--partition"), std::string::npos);
+  EXPECT_EQ(shell_quote("it's"), "'it'\\''s'");
+}
+
+}  // namespace
+}  // namespace actionshift::eval
