@@ -86,6 +86,15 @@ class Decoder {
     if (lag > 0) head_ = (head_ + 1) % lag;
   }
 
+  /// What step(raw, R) would return for `env`, without changing any state: the lag FIFO's oldest
+  /// entry when lag > 0 (the raw action only takes effect `lag` steps later), else the decode
+  /// against the current tracked target. Used by adapters to preview a probe (lag-aware).
+  Action preview(const Action& raw, const Mat3& R = Mat3::Identity(), int env = 0) const {
+    check_env(env);
+    if (contract_.lag() > 0) return history_.col(head_ * num_envs_ + env);
+    return decode(contract_, raw, R, targets_.col(env));
+  }
+
   /// Single-environment step (num_envs must be 1). `reset` = this is the first step of an episode.
   Action step(const Action& raw, const Mat3& R = Mat3::Identity(), bool reset_first = false) {
     if (num_envs_ != 1) throw std::invalid_argument("single-action step needs a decoder with one environment");

@@ -1,0 +1,49 @@
+#pragma once
+/// \file Response calibration: per-channel gain α, noise σ and R² of the TCP response to random
+/// canonical actions on the unwrapped environment (reference §4.1). The calibration JSON's hash
+/// enters every job hash that uses it.
+
+#include "actionshift/adapt/response.hpp"
+#include "actionshift/core/types.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace actionshift::adapt {
+
+/// Result of fitting y ≈ α·x per channel (no intercept).
+struct LinearFit {
+  std::array<double, kPoseDim> alpha{};   ///< Σxy / Σx² (0 if Σx² = 0)
+  std::array<double, kPoseDim> sigma{};   ///< population std of the residual, floored at 1e-4
+  std::array<double, kPoseDim> fit_r2{};  ///< 1 − Σr² / Σ(y − ȳ)² (0 if the denominator is 0)
+};
+
+/// Fits each pose channel of `observed` against the same channel of `commanded`
+/// (reference `fit_linear_response`). Throws std::invalid_argument if sizes differ or are empty.
+LinearFit fit_linear_response(const std::vector<Pose6>& commanded, const std::vector<Pose6>& observed);
+
+/// A task's calibration, as stored in configs/calibration/<task>.json.
+struct ResponseCalibration {
+  std::string task;                ///< e.g. "pick_cube"
+  TcpSlice slice;                  ///< where the TCP pose is in the observation
+  LinearFit fit;                   ///< gains, noise, R²
+  int episodes{0};                 ///< episodes of random actions
+  int steps{0};                    ///< control steps per episode
+  std::uint64_t seed{0};           ///< calibration seed
+  std::string rotation_mode{"live"};  ///< how canonical rotation commands were applied (always live: unwrapped env)
+
+  ResponseModel model() const { return {fit.alpha, fit.sigma}; }
+  /// Canonical JSON (sorted keys, Python-repr floats; schema "actionshift-calibration/1").
+  std::string to_json() const;
+  /// sha256 of to_json(): the calibration hash in job specs.
+  std::string sha256() const;
+  /// Parses and validates; throws InputError(source, field, reason).
+  static ResponseCalibration from_json(const std::string& text, const std::string& source);
+  static ResponseCalibration load(const std::string& path);
+};
+
+}  // namespace actionshift::adapt

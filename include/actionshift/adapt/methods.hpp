@@ -1,0 +1,150 @@
+#pragma once
+/// \file The adapters of the pool-belief ladder (DESIGN §6; reference §5): no adaptation,
+/// privileged oracle, passive exact belief, bounded probing (fixed, random, entropy) and DualABI.
+///
+/// Two deliberate differences from the reference's probe preview (reference §5.2 quirk and
+/// §16.4), both on by default and switchable for parity tests:
+/// - calibrated simulation: a hypothesis' simulated observation is α ⊙ its prediction (the
+///   reference compares α-scaled predictions against the unscaled prediction);
+/// - lag-aware preview: a lagged hypothesis predicts what its FIFO releases this step (the
+///   reference previews every hypothesis as if lag were 0).
+
+#include "actionshift/adapt/adapter.hpp"
+#include "actionshift/adapt/pool_belief.hpp"
+#include "actionshift/core/contract.hpp"
+#include "actionshift/core/decoder.hpp"
+#include "actionshift/core/rng.hpp"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace actionshift::adapt {
+
+/// The floor: sends the backbone's canonical action unchanged.
+class NoAdaptAdapter final : public Adapter {
+ public:
+  std::string name() const override { return "no_adapt"; }
+  void begin_episode(std::uint64_t) override {}
+  Action encode(const Action& canonical, const Mat3&) override { return canonical; }
+  void observe(const Action&, const Pose6&, const Mat3&) override {}
+};
+
+/// The ceiling: knows the true contract (given only by the runner) and inverts it exactly, with
+/// its own decoder replica tracking the same target as the environment's decoder.
+class OracleAdapter final : public Adapter {
+ public:
+  explicit OracleAdapter(const Contract& truth) : replica_(truth) {}
+  std::string name() const override { return "oracle"; }
+  void begin_episode(std::uint64_t) override { replica_.reset_all(); }
+  Action encode(const Action& canonical, const Mat3& R) override {
+    return actionshift::encode(replica_.contract(), canonical, R, replica_.tracked_target());
+  }
+  void observe(const Action& raw, const Pose6&, const Mat3& R) override { replica_.step(raw, R); }
+
+ private:
+  Decoder replica_;
+};
+
+/// Options shared by the probing adapters.
+struct ProbeOptions {
+  int budget{6};              ///< probe steps per episode (reference default 6)
+  double amplitude{0.5};      ///< |raw| bound of every probe channel; the gripper is never actuated
+  bool calibrated_preview{true};  ///< simulate observations as α ⊙ prediction (reference: false)
+  bool lag_aware_preview{true};   ///< preview lagged hypotheses through their FIFO (reference: false)
+  int max_active{32};         ///< at most this many hypotheses enter the preview (largest mass first)
+  double active_mass{1.0 - 1e-9};  ///< ... or fewer, once they hold this much of the belief
+  int probe_channels{6};      ///< pose channels probed (0..5)
+};
+
+/// The 12 probe candidates in the reference's order: +a·e0 … +a·e5, −a·e0 … −a·e5 (gripper 0).
+std::vector<Action> probe_candidates(double amplitude);
+/// The fixed pulse sequence: amplitude·(±1) on channel step % 6, + for (step / 6) even.
+Action fixed_probe_pulse(int step, double amplitude);
+
+/// The active set for a belief: indices of the largest-mass hypotheses (ties by index) until
+/// `mass` is covered or `max_active` are taken; returned in increasing index order.
+std::vector<int> active_hypotheses(const Eigen::VectorXd& probs, int max_active, double mass);
+
+/// Expected posterior entropy of each candidate (reference §5.2 step 2), over the active set.
+std::vector<double> expected_posterior_entropy(const PoolBelief& belief, const std::vector<Action>& candidates,
+                                               const Mat3& R, const ProbeOptions& o);
+
+/// Passive pool belief: acts on the MAP hypothesis and never probes.
+class ExactBeliefAdapter final : public Adapter {
+ public:
+  ExactBeliefAdapter(std::vector<Contract> pool, ResponseModel model) : belief_(std::move(pool), model) {}
+  std::string name() const override { return "exact_belief"; }
+  void begin_episode(std::uint64_t) override { belief_.reset(); }
+  Action encode(const Action& canonical, const Mat3& R) override { return belief_.map_encode(canonical, R); }
+  void observe(const Action& raw, const Pose6& response, const Mat3& R) override { belief_.update(raw, response, R); }
+  const PoolBelief& belief() const { return belief_; }
+
+ private:
+  PoolBelief belief_;
+};
+
+enum class ProbeStrategy { kFixed, kRandom, kEntropy };
+
+/// Pool belief with a bounded probe phase: the first `budget` steps of an episode send probes
+/// chosen by the strategy; afterwards the MAP encoding of the backbone's intent.
+class ProbingAdapter final : public Adapter {
+ public:
+  ProbingAdapter(std::vector<Contract> pool, ResponseModel model, ProbeStrategy strategy, ProbeOptions options = {});
+  std::string name() const override;
+  void begin_episode(std::uint64_t episode_seed) override;
+  Action encode(const Action& canonical, const Mat3& R) override;
+  void observe(const Action& raw, const Pose6& response, const Mat3& R) override { belief_.update(raw, response, R); }
+  StepInfo last_step() const override { return last_; }
+  const PoolBelief& belief() const { return belief_; }
+
+ private:
+  PoolBelief belief_;
+  ProbeStrategy strategy_;
+  ProbeOptions options_;
+  std::vector<Action> candidates_;
+  Rng rng_;
+  int steps_{0};
+  StepInfo last_;
+};
+
+/// DualABI (reference §5.3): probes only while the task regret of acting on the MAP exceeds τ
+/// (sticky stop), choosing the candidate that most reduces the expected regret over the last
+/// `window` canonical intents. The pairwise task error is computed over the active hypotheses only
+/// (ProbeOptions::max_active / active_mass), which keeps it tractable for large pools.
+class DualAbiAdapter final : public Adapter {
+ public:
+  DualAbiAdapter(std::vector<Contract> pool, ResponseModel model, double regret_threshold, ProbeOptions options = {},
+                 int window = 8);
+  std::string name() const override { return "dualabi"; }
+  void begin_episode(std::uint64_t episode_seed) override;
+  Action encode(const Action& canonical, const Mat3& R) override;
+  void observe(const Action& raw, const Pose6& response, const Mat3& R) override { belief_.update(raw, response, R); }
+  StepInfo last_step() const override { return last_; }
+  const PoolBelief& belief() const { return belief_; }
+
+  /// Pairwise task error E[i][j] over `active` (reference §5.3), for the current recent window.
+  Eigen::MatrixXd pairwise_task_error(const std::vector<int>& active, const Mat3& R) const;
+  /// Regret of acting on the MAP of `p` (over the active set): Σ_j p_j E[i*, j].
+  static double regret(const Eigen::VectorXd& p, const Eigen::MatrixXd& E);
+  /// Expected future regret of each candidate (reference §5.3 step 5).
+  std::vector<double> expected_future_regret(const std::vector<int>& active, const Eigen::MatrixXd& E,
+                                             const Mat3& R) const;
+  /// Push an intent into the recent window (the first push of an episode fills every slot).
+  void push_recent(const Action& a);
+
+ private:
+  PoolBelief belief_;
+  double threshold_;
+  ProbeOptions options_;
+  int window_;
+  std::vector<Action> candidates_;
+  std::vector<Action> recent_;  // newest first
+  bool fresh_{true};
+  bool stopped_{false};
+  int steps_{0};
+  StepInfo last_;
+};
+
+}  // namespace actionshift::adapt

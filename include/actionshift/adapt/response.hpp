@@ -1,0 +1,63 @@
+#pragma once
+/// \file The observable response of the robot to an action, and the calibrated Gaussian response
+/// model adapters use as likelihood (reference §4.1–§4.2).
+///
+/// response = [TCP translation (world/base axes, m), rotation vector of q_cur ⊗ conj(q_prev) (rad)]
+/// between two consecutive observations. The calibrated model predicts response_c ≈ α_c·canonical_c
+/// with Gaussian noise σ_c per pose channel.
+
+#include "actionshift/core/types.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <span>
+#include <string>
+
+namespace actionshift::adapt {
+
+/// Hamilton product of two (w, x, y, z) quaternions.
+Eigen::Vector4d quat_multiply(const Eigen::Vector4d& l, const Eigen::Vector4d& r);
+/// Rotation vector of a (w, x, y, z) quaternion (normalised first; reference `quat_to_rotvec`).
+Vec3 quat_to_rotvec(const Eigen::Vector4d& q);
+
+/// Where the TCP pose sits in a flat observation vector.
+struct TcpSlice {
+  int position_start{-1};    ///< offset of x y z [m]
+  int quaternion_start{-1};  ///< offset of w x y z
+};
+
+/// TCP response between two observations: translation (3) then relative rotation vector (3).
+/// Throws std::invalid_argument if the slice does not fit the observations.
+Pose6 tcp_response(std::span<const double> prev_obs, std::span<const double> cur_obs, const TcpSlice& slice);
+
+/// Orientation matrix of the TCP in an observation (the frame rotation adapters feed to decoders).
+Mat3 tcp_rotation(std::span<const double> obs, const TcpSlice& slice);
+
+/// Calibrated per-channel Gaussian response model.
+struct ResponseModel {
+  std::array<double, kPoseDim> alpha{1, 1, 1, 1, 1, 1};  ///< response per unit canonical command (m or rad)
+  std::array<double, kPoseDim> sigma{1, 1, 1, 1, 1, 1};  ///< noise std of the response (m or rad), > 0
+
+  /// Throws std::invalid_argument unless every α is finite and non-zero and every σ finite > 0.
+  void validate() const;
+
+  /// α ⊙ canonical pose.
+  Pose6 expected(const Action& canonical) const {
+    Pose6 e;
+    for (int c = 0; c < kPoseDim; ++c) e[c] = alpha[static_cast<std::size_t>(c)] * canonical[c];
+    return e;
+  }
+  /// −½ Σ_c ((observed_c − α_c·predicted_c)/σ_c)², without the normalising constant.
+  double log_likelihood(const Action& predicted_canonical, const Pose6& observed) const {
+    double s = 0.0;
+    for (int c = 0; c < kPoseDim; ++c) {
+      const auto k = static_cast<std::size_t>(c);
+      const double r = (observed[c] - alpha[k] * predicted_canonical[c]) / sigma[k];
+      s += r * r;
+    }
+    return -0.5 * s;
+  }
+};
+
+}  // namespace actionshift::adapt

@@ -1,0 +1,131 @@
+#include "actionshift/adapt/calibration.hpp"
+
+#include "actionshift/core/canonical_json.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace actionshift::adapt {
+
+namespace {
+constexpr const char* kSchema = "actionshift-calibration/1";
+}
+
+LinearFit fit_linear_response(const std::vector<Pose6>& x, const std::vector<Pose6>& y) {
+  if (x.empty() || x.size() != y.size())
+    throw std::invalid_argument("fit_linear_response: need the same non-zero number of commands and responses");
+  LinearFit f;
+  const double n = static_cast<double>(x.size());
+  for (int c = 0; c < kPoseDim; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    double sxy = 0, sxx = 0, sy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      sxy += x[i][c] * y[i][c];
+      sxx += x[i][c] * x[i][c];
+      sy += y[i][c];
+    }
+    const double a = sxx > 0 ? sxy / sxx : 0.0;
+    const double ybar = sy / n;
+    double srr = 0, sr = 0, stt = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double r = y[i][c] - a * x[i][c];
+      srr += r * r;
+      sr += r;
+      stt += (y[i][c] - ybar) * (y[i][c] - ybar);
+    }
+    const double var = srr / n - (sr / n) * (sr / n);  // population variance of the residual
+    f.alpha[k] = a;
+    f.sigma[k] = std::max(std::sqrt(std::max(var, 0.0)), 1e-4);
+    f.fit_r2[k] = stt > 0 ? 1.0 - srr / stt : 0.0;
+  }
+  return f;
+}
+
+std::string ResponseCalibration::to_json() const {
+  nlohmann::json j;
+  j["schema_version"] = kSchema;
+  j["task"] = task;
+  j["position_start"] = slice.position_start;
+  j["quaternion_start"] = slice.quaternion_start;
+  j["alpha"] = fit.alpha;
+  j["sigma"] = fit.sigma;
+  j["fit_r2"] = fit.fit_r2;
+  j["episodes"] = episodes;
+  j["steps"] = steps;
+  j["seed"] = seed;
+  j["rotation_mode"] = rotation_mode;
+  return canonical_dump(j);
+}
+
+std::string ResponseCalibration::sha256() const { return sha256_hex(to_json()); }
+
+ResponseCalibration ResponseCalibration::from_json(const std::string& text, const std::string& source) {
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
+  if (!j.is_object()) throw InputError(source, "", "calibration must be a JSON object");
+  static const char* kKeys[] = {"schema_version", "task", "position_start", "quaternion_start", "alpha", "sigma",
+                                "fit_r2", "episodes", "steps", "seed", "rotation_mode"};
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool known = false;
+    for (const char* k : kKeys) known = known || it.key() == k;
+    if (!known) throw InputError(source, it.key(), "unknown field");
+  }
+  for (const char* k : kKeys)
+    if (!j.contains(k)) throw InputError(source, k, "missing field");
+  if (j["schema_version"] != kSchema) throw InputError(source, "schema_version", std::string("expected '") + kSchema + "'");
+  ResponseCalibration c;
+  auto str = [&](const char* k) {
+    if (!j[k].is_string()) throw InputError(source, k, "must be a string");
+    return j[k].get<std::string>();
+  };
+  auto integer = [&](const char* k, long long lo) {
+    if (!j[k].is_number_integer() || j[k].get<long long>() < lo)
+    {
+      std::string msg = "must be an integer >= ";
+      msg += std::to_string(lo);
+      throw InputError(source, k, msg);
+    }
+    return j[k].get<long long>();
+  };
+  auto six = [&](const char* k, std::array<double, kPoseDim>& out) {
+    if (!j[k].is_array() || j[k].size() != 6) throw InputError(source, k, "must be a list of 6 numbers");
+    for (std::size_t i = 0; i < 6; ++i) {
+      if (!j[k][i].is_number()) throw InputError(source, k, "must be a list of 6 numbers");
+      out[i] = j[k][i].get<double>();
+      if (!std::isfinite(out[i])) throw InputError(source, k, "must be finite");
+    }
+  };
+  c.task = str("task");
+  c.rotation_mode = str("rotation_mode");
+  c.slice.position_start = static_cast<int>(integer("position_start", 0));
+  c.slice.quaternion_start = static_cast<int>(integer("quaternion_start", 0));
+  c.episodes = static_cast<int>(integer("episodes", 1));
+  c.steps = static_cast<int>(integer("steps", 2));
+  if (!j["seed"].is_number_unsigned()) throw InputError(source, "seed", "must be a nonnegative integer");
+  c.seed = j["seed"].get<std::uint64_t>();
+  six("alpha", c.fit.alpha);
+  six("sigma", c.fit.sigma);
+  six("fit_r2", c.fit.fit_r2);
+  try {
+    c.model().validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(source, "alpha/sigma", e.what());
+  }
+  return c;
+}
+
+ResponseCalibration ResponseCalibration::load(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return from_json(ss.str(), path);
+}
+
+}  // namespace actionshift::adapt
