@@ -37,29 +37,43 @@ Eigen::Isometry3d target_pose(const Eigen::Isometry3d& tcp_in_base, const PoseCo
 
 IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
                   const Eigen::Isometry3d& target, const IkOptions& options) {
-  IkResult best;
-  best.q = q0;
-  best.error = INFINITY;
-  ChainVector q = q0.cwiseMax(chain.lower()).cwiseMin(chain.upper());
+  // levenberg-marquardt style clik: damped least-squares steps, each limited to max_step rad per
+  // joint and clamped to the joint limits; a step that does not reduce the error is rejected and
+  // the damping raised
   Eigen::Isometry3d tip;
   ChainJacobian jac;
-  Eigen::Matrix<double, 6, 1> err;
-  for (int it = 0; it <= options.max_iterations; ++it) {
+  auto error_of = [&](const ChainVector& q, Eigen::Matrix<double, 6, 1>& err) {
     chain.fk_jacobian(q, tip, jac);
     err.head<3>() = target.translation() - tip.translation();
     err.tail<3>() = so3_log(target.linear() * tip.linear().transpose());
-    const double e = err.norm();
+    return err.norm();
+  };
+  IkResult best;
+  best.q = q0.cwiseMax(chain.lower()).cwiseMin(chain.upper());
+  Eigen::Matrix<double, 6, 1> err;
+  best.error = error_of(best.q, err);
+  ChainJacobian best_jac = jac;
+  Eigen::Matrix<double, 6, 1> best_err = err;
+  double lambda = options.damping;
+  for (int it = 1; it <= options.max_iterations && best.error >= options.tolerance; ++it) {
+    Eigen::Matrix<double, 6, 6> a = best_jac * best_jac.transpose();
+    a.diagonal().array() += lambda;
+    ChainVector dq = best_jac.transpose() * a.ldlt().solve(best_err);
+    const double biggest = dq.cwiseAbs().maxCoeff();
+    if (biggest > options.max_step) dq *= options.max_step / biggest;
+    const ChainVector q = (best.q + dq).cwiseMax(chain.lower()).cwiseMin(chain.upper());
+    const double e = error_of(q, err);
     if (e < best.error) {
-      best.error = e;
       best.q = q;
+      best.error = e;
       best.iterations = it;
+      best_jac = jac;
+      best_err = err;
+      lambda = std::max(options.damping, lambda * 0.1);
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e6) break;
     }
-    if (e < options.tolerance || it == options.max_iterations) break;
-    Eigen::Matrix<double, 6, 6> a = jac * jac.transpose();
-    a.diagonal().array() += options.damping;
-    const Eigen::Matrix<double, 6, 1> y = a.ldlt().solve(err);
-    q += jac.transpose() * y;
-    q = q.cwiseMax(chain.lower()).cwiseMin(chain.upper());
   }
   return best;
 }

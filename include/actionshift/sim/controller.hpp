@@ -33,9 +33,10 @@ Eigen::Isometry3d target_pose(const Eigen::Isometry3d& tcp_in_base, const PoseCo
 
 /// Damped-least-squares CLIK settings.
 struct IkOptions {
-  int max_iterations{20};    ///< Newton-style iterations (full steps)
-  double damping{1e-4};      ///< lambda^2 added to J J^T
-  double tolerance{1e-10};   ///< stop when |error| (m and rad) is below this
+  int max_iterations{30};    ///< damped-least-squares iterations
+  double damping{1e-4};      ///< minimum lambda^2 added to J J^T (raised when a step fails)
+  double max_step{0.2};      ///< [rad] largest joint change per iteration
+  double tolerance{1e-10};   ///< stop when |error| (m and rad stacked) is below this
 };
 
 /// Result of an IK solve.
@@ -45,8 +46,9 @@ struct IkResult {
   int iterations{0};
 };
 
-/// Solve for joints reaching `target` (root frame) from q0, clamping to joint limits every iteration.
-/// Returns the best iterate seen. Allocation-free.
+/// Solve for joints reaching `target` (root frame) from q0: Levenberg-Marquardt style CLIK, each
+/// step limited to IkOptions::max_step per joint and clamped to the joint limits. Returns the best
+/// iterate seen (q0 clamped if nothing improves). Allocation-free.
 IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
                   const Eigen::Isometry3d& target, const IkOptions& options = {});
 
