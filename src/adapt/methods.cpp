@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -56,16 +57,29 @@ Pose6 simulated_observation(const ResponseModel& m, const Action& pred, bool cal
   return calibrated ? m.expected(pred) : Pose6(pred.head<kPoseDim>());
 }
 
-// posterior over `active` after observing `obs`, given the current log belief
-void posterior(const PoolBelief& b, const std::vector<int>& active, const std::vector<Action>& preds, const Pose6& obs,
-               Eigen::VectorXd& out) {
+// posterior over `active` after observing `obs`, given the current log belief; returns its
+// entropy [nats] (one exp per hypothesis and a single log)
+double posterior(const PoolBelief& b, const std::vector<int>& active, const std::vector<Action>& preds, const Pose6& obs,
+                 Eigen::VectorXd& out) {
   const auto& logp = b.log_probs();
-  out.resize(static_cast<Eigen::Index>(active.size()));
-  for (std::size_t j = 0; j < active.size(); ++j)
-    out[static_cast<Eigen::Index>(j)] =
-        logp[active[j]] + b.model().log_likelihood(preds[static_cast<std::size_t>(active[j])], obs);
-  const double z = logsumexp(out);
-  out = (out.array() - z).exp();
+  const auto n = static_cast<Eigen::Index>(active.size());
+  out.resize(n);
+  double m = -std::numeric_limits<double>::infinity();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const int h = active[static_cast<std::size_t>(j)];
+    out[j] = logp[h] + b.model().log_likelihood(preds[static_cast<std::size_t>(h)], obs);
+    m = std::max(m, out[j]);
+  }
+  double sum = 0, weighted = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double x = out[j] - m;
+    const double e = std::exp(x);
+    out[j] = e;
+    sum += e;
+    weighted += e * x;
+  }
+  out /= sum;
+  return std::log(sum) - weighted / sum;  // −Σ p ln p with ln p = x − ln Σe
 }
 
 }  // namespace
@@ -84,10 +98,8 @@ std::vector<double> expected_posterior_entropy(const PoolBelief& b, const std::v
     b.preview(c, R, o.lag_aware_preview, preds);
     double eh = 0;
     for (int h : active) {
-      posterior(b, active, preds, simulated_observation(b.model(), preds[static_cast<std::size_t>(h)], o.calibrated_preview), post);
-      double ent = 0;
-      for (Eigen::Index j = 0; j < post.size(); ++j)
-        if (post[j] > 0) ent -= post[j] * std::log(post[j]);
+      const double ent = posterior(b, active, preds,
+                                   simulated_observation(b.model(), preds[static_cast<std::size_t>(h)], o.calibrated_preview), post);
       eh += p[h] / mass * ent;
     }
     out.push_back(eh);

@@ -1,0 +1,67 @@
+// Per-environment-step cost of the pool belief and probe selection. Budgets (issue 6): belief
+// update <= 2 us for 9 hypotheses and <= 20 us for the full pool; entropy or DualABI selection
+// <= 50 us per step for 9 hypotheses.
+#include "actionshift/adapt/methods.hpp"
+#include "actionshift/core/reference_contracts.hpp"
+#include "actionshift/data/builtin_manifests.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+namespace {
+
+using namespace actionshift;
+using namespace actionshift::adapt;
+
+const ResponseModel kModel{{0.032, 0.016, 0.018, -0.035, -0.027, -0.038}, {0.03, 0.02, 0.02, 0.04, 0.05, 0.04}};
+
+std::vector<Contract> pool(int which) {
+  return which == 0 ? reference::pool9() : data::resolve_manifest("full").contracts();
+}
+
+Action intent(int k) {
+  Action a;
+  for (int c = 0; c < 7; ++c) a[c] = 0.9 * std::sin(k + c);
+  return a;
+}
+
+void BM_BeliefUpdate(benchmark::State& state) {
+  PoolBelief b(pool(static_cast<int>(state.range(0))), kModel);
+  const Contract truth = reference::oracle_contract();
+  Decoder env(truth);
+  int k = 0;
+  for (auto _ : state) {
+    const Action raw = intent(k++);
+    const Pose6 obs = kModel.expected(env.step(raw));
+    b.update(raw, obs, Mat3::Identity());
+    if (k % 50 == 0) b.reset();  // stay in the informative regime
+  }
+  state.SetLabel(std::to_string(b.size()) + " hypotheses");
+}
+BENCHMARK(BM_BeliefUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// selection from a fresh (uniform) belief: the most expensive point of an episode
+void BM_EntropySelect(benchmark::State& state) {
+  ProbingAdapter p(pool(static_cast<int>(state.range(0))), kModel, ProbeStrategy::kEntropy);
+  for (auto _ : state) {
+    p.begin_episode(1);
+    Action raw = p.encode(intent(0), Mat3::Identity());
+    benchmark::DoNotOptimize(raw);
+  }
+  state.SetLabel(std::to_string(p.belief().size()) + " hypotheses");
+}
+BENCHMARK(BM_EntropySelect)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+void BM_DualAbiSelect(benchmark::State& state) {
+  DualAbiAdapter d(pool(static_cast<int>(state.range(0))), kModel, 0.0);
+  for (auto _ : state) {
+    d.begin_episode(1);
+    Action raw = d.encode(intent(0), Mat3::Identity());
+    benchmark::DoNotOptimize(raw);
+  }
+  state.SetLabel(std::to_string(d.belief().size()) + " hypotheses");
+}
+BENCHMARK(BM_DualAbiSelect)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
