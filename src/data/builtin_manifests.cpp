@@ -10,7 +10,22 @@ namespace actionshift::data {
 namespace detail {
 extern const std::pair<std::string_view, const std::string_view*> kBuiltinManifests[];
 extern const int kBuiltinManifestCount;
+extern const std::pair<std::string_view, const std::string_view*> kBuiltinCalibrations[];
+extern const int kBuiltinCalibrationCount;
 }  // namespace detail
+
+std::optional<std::string_view> builtin_calibration_text(std::string_view task) {
+  for (int i = 0; i < detail::kBuiltinCalibrationCount; ++i)
+    if (detail::kBuiltinCalibrations[i].first == task) return *detail::kBuiltinCalibrations[i].second;
+  return std::nullopt;
+}
+
+std::vector<std::string> builtin_calibration_tasks() {
+  std::vector<std::string> names;
+  for (int i = 0; i < detail::kBuiltinCalibrationCount; ++i) names.emplace_back(detail::kBuiltinCalibrations[i].first);
+  std::sort(names.begin(), names.end());
+  return names;
+}
 
 std::vector<std::string> builtin_manifest_names() {
   std::vector<std::string> names;

@@ -1,0 +1,100 @@
+#include "actionshift/adapt/registry.hpp"
+
+#include "actionshift/adapt/methods.hpp"
+#include "actionshift/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace actionshift::adapt {
+
+const std::vector<std::string>& method_names() {
+  static const std::vector<std::string> n{"oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes",
+                                          "exact_belief", "no_adapt"};
+  return n;
+}
+
+bool method_needs_pool(const std::string& m) { return m != "oracle" && m != "no_adapt"; }
+bool method_needs_calibration(const std::string& m) { return method_needs_pool(m); }
+
+namespace {
+
+nlohmann::json defaults(const std::string& m) {
+  if (m == "oracle" || m == "no_adapt" || m == "exact_belief") return nlohmann::json::object();
+  nlohmann::json p = {{"budget", 6}, {"amplitude", 0.5}};
+  if (m == "entropy_probes" || m == "dualabi") {
+    p["calibrated_preview"] = true;
+    p["lag_aware_preview"] = true;
+    p["max_active"] = 32;
+  }
+  if (m == "dualabi") {
+    p["tau"] = 1.5;  // the reference's runner value; docs/results/dualabi_pilot.md freezes ours
+    p["window"] = 8;
+  }
+  return p;
+}
+
+ProbeOptions probe_options(const nlohmann::json& p) {
+  ProbeOptions o;
+  o.budget = p.at("budget").get<int>();
+  o.amplitude = p.at("amplitude").get<double>();
+  if (p.contains("calibrated_preview")) o.calibrated_preview = p["calibrated_preview"].get<bool>();
+  if (p.contains("lag_aware_preview")) o.lag_aware_preview = p["lag_aware_preview"].get<bool>();
+  if (p.contains("max_active")) o.max_active = p["max_active"].get<int>();
+  return o;
+}
+
+}  // namespace
+
+nlohmann::json resolve_method_params(const std::string& method, const nlohmann::json& params) {
+  const auto& names = method_names();
+  if (std::find(names.begin(), names.end(), method) == names.end()) {
+    std::string known;
+    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw InputError("method", method, "unknown method (known: " + known + ")");
+  }
+  if (!params.is_object()) throw InputError("method", method, "parameters must be a JSON object");
+  nlohmann::json out = defaults(method);
+  for (auto it = params.begin(); it != params.end(); ++it) {
+    if (!out.contains(it.key())) throw InputError("method " + method, it.key(), "unknown parameter");
+    const auto& d = out[it.key()];
+    const auto& v = it.value();
+    const bool ok = (d.is_boolean() && v.is_boolean()) || (d.is_number_integer() && v.is_number_integer()) ||
+                    (d.is_number_float() && v.is_number());
+    if (!ok) throw InputError("method " + method, it.key(), "wrong type (expected like " + d.dump() + ")");
+    out[it.key()] = d.is_number_float() ? nlohmann::json(v.get<double>()) : v;
+  }
+  if (out.contains("budget") && (out["budget"].get<int>() < 0 || out["budget"].get<int>() > 1000))
+    throw InputError("method " + method, "budget", "must be in [0, 1000]");
+  if (out.contains("amplitude")) {
+    const double a = out["amplitude"].get<double>();
+    if (!(a > 0.0 && a <= 1.0)) throw InputError("method " + method, "amplitude", "must be in (0, 1]");
+  }
+  if (out.contains("max_active") && out["max_active"].get<int>() < 1)
+    throw InputError("method " + method, "max_active", "must be at least 1");
+  if (out.contains("tau") && !(out["tau"].get<double>() >= 0.0 && std::isfinite(out["tau"].get<double>())))
+    throw InputError("method " + method, "tau", "must be finite and nonnegative");
+  if (out.contains("window") && out["window"].get<int>() < 1) throw InputError("method " + method, "window", "must be at least 1");
+  return out;
+}
+
+std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& p, const MethodInputs& in) {
+  if (method == "no_adapt") return std::make_unique<NoAdaptAdapter>();
+  if (method == "oracle") {
+    if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given only by the runner)");
+    return std::make_unique<OracleAdapter>(*in.truth);
+  }
+  if (!in.pool || in.pool->empty()) throw InputError("method", method, "needs a pool (--pool)");
+  if (!in.model) throw InputError("method", method, "needs a response calibration");
+  if (method == "exact_belief") return std::make_unique<ExactBeliefAdapter>(*in.pool, *in.model);
+  if (method == "fixed_probes") return std::make_unique<ProbingAdapter>(*in.pool, *in.model, ProbeStrategy::kFixed, probe_options(p));
+  if (method == "random_probes") return std::make_unique<ProbingAdapter>(*in.pool, *in.model, ProbeStrategy::kRandom, probe_options(p));
+  if (method == "entropy_probes")
+    return std::make_unique<ProbingAdapter>(*in.pool, *in.model, ProbeStrategy::kEntropy, probe_options(p));
+  if (method == "dualabi")
+    return std::make_unique<DualAbiAdapter>(*in.pool, *in.model, p.at("tau").get<double>(), probe_options(p),
+                                            p.at("window").get<int>());
+  throw InputError("method", method, "unknown method");
+}
+
+}  // namespace actionshift::adapt
