@@ -207,6 +207,25 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
 
 Experiment load_experiment(const std::string& path) { return parse_experiment(detail::read_file(path), path); }
 
+JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
+  if (!resolver.split || !resolver.backbone) throw std::invalid_argument("resolve_job: resolver needs split and backbone");
+  if (q.pool && !resolver.pool) throw InputError("command line", "pool", "pools cannot be resolved here");
+  if (resolver.check_method) resolver.check_method(q.method);
+  JobSpec job;
+  job.task = q.task;
+  job.split = resolver.split(q.task, q.split);
+  job.method = q.method.name;
+  job.method_params = q.method.params;
+  job.backbone = resolver.backbone(q.task, q.backbone);
+  if (q.pool) job.pool = resolver.pool(*q.pool);
+  job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, q.method) : std::nullopt;
+  job.rotation_mode = q.rotation_mode;
+  job.seed = q.seed;
+  job.episodes = q.episodes;
+  validate_job(job, "command line");
+  return job;
+}
+
 Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("make_plan: resolver needs split and backbone");
   if (ex.pool && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");

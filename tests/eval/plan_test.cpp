@@ -111,6 +111,23 @@ TEST(Plan, CartesianProductInStableOrder) {
   EXPECT_EQ(ids.size(), plan.jobs.size());
 }
 
+TEST(Plan, SingleJobRequestMatchesThePlanEntry) {
+  const Plan plan = make_plan(parse_experiment(kYaml, "tiny.yaml"), fake_resolver());
+  JobRequest q;
+  q.task = "push_cube";
+  q.split = "long_lag";
+  q.method = {"fixed_probes", "{\"amplitude\":0.5,\"budget\":6,\"label\":\"x\",\"on\":true}"};
+  q.seed = 2;
+  q.episodes = 16;
+  const JobSpec job = resolve_job(q, fake_resolver());
+  EXPECT_EQ(job_id(job), plan.jobs[22].job_id);  // push_cube (12) + long_lag (6) + fixed_probes (3) + seed 2 (1)
+  q.method.name = "telepathy";
+  EXPECT_THAT([&] { resolve_job(q, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("unknown method")));
+  q.method.name = "oracle";
+  q.episodes = 0;
+  EXPECT_THAT([&] { resolve_job(q, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("command line: episodes: must be > 0")));
+}
+
 TEST(Plan, ResolverErrorsPropagate) {
   auto ex = parse_experiment(kYaml, "tiny.yaml");
   ex.splits.push_back("missing");

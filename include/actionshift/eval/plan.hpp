@@ -59,6 +59,23 @@ struct PlanResolver {
   std::function<void(const MethodEntry& method)> check_method;
 };
 
+/// A single job by names, as on the `actionshift run --task T --split S --method M ...` command line.
+struct JobRequest {
+  std::string task;                   ///< task name
+  std::string split;                  ///< split name
+  MethodEntry method;                 ///< method and parameters
+  std::string backbone{"expert"};     ///< backbone name
+  std::optional<std::string> pool;    ///< pool name, or none
+  std::string rotation_mode{"live"};  ///< "live" or "identity"
+  std::uint64_t seed{20260718};       ///< experimental seed
+  std::int64_t episodes{256};         ///< episodes
+};
+
+/// Resolve a request into a validated JobSpec with the same resolver `plan` uses, so a job run from
+/// the command line has the same id as the same job run from a plan.
+/// Throws actionshift::InputError from the resolver or for an invalid field (source "command line").
+JobSpec resolve_job(const JobRequest& request, const PlanResolver& resolver);
+
 /// One job of a plan.
 struct PlannedJob {
   std::int64_t index{0};   ///< position in the plan (the Slurm array task id)
