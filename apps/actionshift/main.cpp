@@ -66,6 +66,21 @@ int main(int argc, char** argv) {
   gen->add_option("--rule", gen_o.rules, "Only these rules (repeatable; default: all)");
   gen->callback([&] { action = [&] { return cli::run_splits_generate(gen_o); }; });
 
+  // ---- bench env (sim layer)
+  auto* bench = app.add_subcommand("bench", "Performance measurements");
+  bench->require_subcommand(1);
+  cli::BenchEnvOptions bench_env_o;
+  auto* bench_env = bench->add_subcommand(
+      "env", "Control steps per second of the Bullet environment (scripted grasp-and-lift, with contact),\n"
+             "on one thread and on all threads");
+  bench_env->add_option("--task", bench_env_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")
+      ->capture_default_str();
+  bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
+  bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
+      ->capture_default_str();
+  bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
+  bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

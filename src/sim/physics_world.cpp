@@ -218,7 +218,11 @@ void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::
   dispatcher_.reset();
   collision_config_.reset();
 
-  collision_config_ = std::make_unique<btDefaultCollisionConfiguration>();
+  // small pools: a fresh configuration per episode must be cheap (the default pools are ~4 MB)
+  btDefaultCollisionConstructionInfo cci;
+  cci.m_defaultMaxPersistentManifoldPoolSize = 64;
+  cci.m_defaultMaxCollisionAlgorithmPoolSize = 64;
+  collision_config_ = std::make_unique<btDefaultCollisionConfiguration>(cci);
   dispatcher_ = std::make_unique<btCollisionDispatcher>(collision_config_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
   solver_ = std::make_unique<btMultiBodyConstraintSolver>();
@@ -235,6 +239,7 @@ void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::
     info.m_friction = cfg_.default_friction;
     info.m_restitution = 0.0;
     table_ = std::make_unique<btRigidBody>(info);
+    table_->setContactProcessingThreshold(cfg_.contact_processing_threshold);
     world_->addRigidBody(table_.get(), kGroupStatic, kMaskAll ^ kGroupStatic);
   }
 
@@ -262,6 +267,7 @@ void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::
     info.m_restitution = 0.0;
     auto body = std::make_unique<btRigidBody>(info);
     body->setActivationState(DISABLE_DEACTIVATION);
+    body->setContactProcessingThreshold(cfg_.contact_processing_threshold);
     if (cfg_.friction_anchors) body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_HAS_FRICTION_ANCHOR);
     if (spec.mass > 0.0)
       world_->addRigidBody(body.get(), kGroupDefault, kMaskAll);
@@ -328,6 +334,7 @@ void PhysicsWorld::build_robot(const Eigen::VectorXd& qpos) {
     const bool finger = std::find(finger_bodies_.begin(), finger_bodies_.end(), i) != finger_bodies_.end();
     col->setFriction(finger ? cfg_.finger_friction : cfg_.default_friction);
     col->setRestitution(0.0);
+    col->setContactProcessingThreshold(cfg_.contact_processing_threshold);
     if (finger && cfg_.friction_anchors) col->setCollisionFlags(col->getCollisionFlags() | btCollisionObject::CF_HAS_FRICTION_ANCHOR);
     world_->addCollisionObject(col.get(), kGroupDefault, kMaskAll);
     robot_->getLink(i).m_collider = col.get();

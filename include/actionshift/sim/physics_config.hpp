@@ -11,8 +11,8 @@ namespace actionshift::sim {
 struct PhysicsConfig {
   double control_dt_s{0.05};          ///< one control step (20 Hz)
   int sim_steps_per_control{5};       ///< 100 Hz simulation steps per control step
-  int substeps_per_sim_step{2};       ///< Bullet steps per simulation step (5 ms physics)
-  int solver_iterations{10};          ///< sequential-impulse iterations per Bullet step
+  int substeps_per_sim_step{1};       ///< Bullet steps per simulation step (1: 10 ms physics; 2: 5 ms, see docs/sim.md)
+  int solver_iterations{15};          ///< sequential-impulse iterations per Bullet step
   double gravity{9.81};               ///< [m/s^2], objects only; the robot is gravity compensated exactly
   double drive_stiffness{1000.0};     ///< K of ManiSkill's joint PD drive [N m/rad] or [N/m]
   double drive_damping{100.0};        ///< D of ManiSkill's joint PD drive [N m s/rad] or [N s/m]
@@ -22,6 +22,7 @@ struct PhysicsConfig {
   double finger_friction{1.15 / std::sqrt(0.3)};  ///< finger pads: product with default = 1.15 = PhysX avg(2.0, 0.3)
   bool finger_gear{true};             ///< btMultiBodyGearConstraint between the fingers (mimic)
   bool friction_anchors{true};        ///< CF_HAS_FRICTION_ANCHOR on fingers and objects
+  double contact_processing_threshold{0.005};  ///< [m] manifold points farther apart than this make no solver rows
   bool arm_joint_limits{false};       ///< limit constraints on the arm joints too (the IK keeps targets inside; fingers always)
 };
 
