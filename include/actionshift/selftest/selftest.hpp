@@ -1,0 +1,122 @@
+#pragma once
+/// \file Plug-and-verify self-test with the control loop inverted (DESIGN §1, reference §11): the
+/// caller's controller owns the robot. It asks for the next bounded probe, sends it, feeds back the
+/// measured TCP pose, and after the budget asks for the verdict. Depends on core and the pool belief
+/// only (no simulator).
+///
+/// \code
+///   actionshift::selftest::Options o;            // expected = identity, library pool, entropy, budget 6
+///   o.model = my_calibration.model();            // α, σ of the robot's TCP response per unit command
+///   std::string err;
+///   auto st = actionshift::selftest::SelfTest::create(o, &err);   // non-throwing twin
+///   if (!st) { log(err); return; }
+///   st->begin(read_tcp_pose());
+///   while (auto raw = st->next_probe()) {        // nullopt once the budget is spent
+///     robot.send(*raw);                          // |pose channel| <= amplitude, gripper 0
+///     st->observe(read_tcp_pose());
+///   }
+///   auto v = st->verdict();                      // PASS / MISMATCH / INCONCLUSIVE, with reasons
+/// \endcode
+
+#include "actionshift/adapt/methods.hpp"
+#include "actionshift/adapt/response.hpp"
+#include "actionshift/core/contract.hpp"
+#include "actionshift/core/types.hpp"
+#include "actionshift/selftest/verdict.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace actionshift::selftest {
+
+enum class Strategy {
+  kFixed,    ///< +amplitude on channels 0..5 in turn, then −amplitude, ... (reference `fixed_probe_pulse`)
+  kEntropy,  ///< greedy one-step minimum expected posterior entropy over the 12 axis pulses
+};
+const char* to_string(Strategy s);  ///< "fixed" or "entropy"
+
+/// Where the rotation used to decode `tool`-frame hypotheses comes from.
+enum class FrameRotation {
+  kMeasured,  ///< the measured TCP orientation before each probe (the robot's live tool frame)
+  kIdentity,  ///< R = I (the reference's headline setting): tool equals base, so frame is not checked
+};
+
+/// A measured TCP pose in the robot base frame.
+struct TcpPose {
+  Vec3 position{Vec3::Zero()};                          ///< [m] (or the caller's unit)
+  Eigen::Vector4d quaternion{1.0, 0.0, 0.0, 0.0};       ///< orientation, w x y z (need not be normalised)
+  std::optional<Eigen::Vector2d> fingers;               ///< optional finger joint positions [m]
+};
+
+/// Self-test settings (reference §11 defaults). Validated by validate(), by create() and by the
+/// throwing constructor through the same checker.
+struct Options {
+  Contract expected;                ///< the wiring the policy assumes (default identity)
+  std::vector<Contract> pool;       ///< declared candidate wirings; empty: the library pool (library.hpp)
+                                    ///< `expected` is appended to either if absent
+  adapt::ResponseModel model{{1, 1, 1, 1, 1, 1}, {0.05, 0.05, 0.05, 0.05, 0.05, 0.05}};  ///< response per unit canonical command
+  Strategy strategy{Strategy::kEntropy};  ///< probe choice
+  int budget{6};                    ///< probe steps, in [1, 10000]
+  double amplitude{0.5};            ///< |raw| bound of every probe pose channel, in (0, 1]
+  double confidence_floor{0.9};     ///< a field is resolved iff its confidence >= this, in (0, 1]
+  double misspec_ratio{4.0};        ///< abstain if the MAP's fit ratio exceeds this, > 0
+  FrameRotation frame_rotation{FrameRotation::kMeasured};  ///< rotation for tool-frame decoding
+  double min_frame_angle{0.2};      ///< [rad] frame is checked only if the TCP orientation stays at least this far from identity
+  std::uint64_t seed{20260720};     ///< seeds the probe adapter (unused by fixed and entropy)
+};
+
+/// Checks `o`; on failure returns false and sets `*err` (if non-null) to one line naming the field,
+/// the rule and the value, e.g. "selftest options: budget must be in [1, 10000] (got 0)".
+bool validate(const Options& o, std::string* err) noexcept;
+
+class SelfTest {
+ public:
+  /// Throws std::invalid_argument with validate()'s message for invalid options.
+  explicit SelfTest(const Options& options);
+  /// Non-throwing twin for embedded use: nullopt and `*err` set for invalid options.
+  static std::optional<SelfTest> create(const Options& options, std::string* err) noexcept;
+
+  SelfTest(SelfTest&&) noexcept;
+  SelfTest& operator=(SelfTest&&) noexcept;
+  ~SelfTest();
+
+  /// Start (or restart) the test at the robot's current pose. Throws std::invalid_argument for a
+  /// non-finite pose or a zero quaternion.
+  void begin(const TcpPose& start);
+  /// Non-throwing twin of begin(): false and `*err` set for a bad pose.
+  bool try_begin(const TcpPose& start, std::string* err) noexcept;
+
+  /// The next raw 7-vector to send (|pose channel| <= amplitude, gripper exactly 0), or nullopt
+  /// once the budget is spent. Calling it again before observe() returns the same probe.
+  /// Throws std::logic_error if begin() was not called.
+  std::optional<Action> next_probe();
+
+  /// The pose measured after the robot executed the last probe. Throws std::logic_error if no probe
+  /// is outstanding, std::invalid_argument for a non-finite pose or a zero quaternion.
+  void observe(const TcpPose& pose);
+  /// Non-throwing twin of observe(): false and `*err` set (the sample is ignored).
+  bool try_observe(const TcpPose& pose, std::string* err) noexcept;
+
+  bool done() const noexcept;          ///< the budget is spent (every probe observed)
+  int probes_observed() const noexcept;
+  const Options& options() const noexcept;
+  const std::vector<Contract>& pool() const noexcept;  ///< the declared pool, expected included
+  /// Posterior over pool() (uniform before any observation).
+  Eigen::VectorXd posterior() const;
+
+  /// The evidence so far (usable before the budget is spent: fewer probes, less confidence).
+  Evidence evidence() const;
+  /// decide_verdict(evidence(), floor, ratio) plus the probe accounting.
+  Verdict verdict() const;
+
+ private:
+  struct Impl;
+  explicit SelfTest(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace actionshift::selftest
