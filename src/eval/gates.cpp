@@ -3,6 +3,7 @@
 #include "actionshift/core/error.hpp"
 
 #include <nlohmann/json.hpp>
+#include <iomanip>
 
 #include <algorithm>
 #include <cmath>
@@ -399,11 +400,13 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
     c.expected = it.value()["verdict"].get<std::string>();
     const bool present = ac.contains(c.cell);
     c.actual = present ? ac[c.cell]["verdict"].get<std::string>() : "missing";
-    c.regression = c.expected == "pass" && c.actual != "pass";
+    // a positive verdict (gate1 "pass", gate0 "advance", promotion "promote") that is lost regresses
+    const bool positive = c.expected == "pass" || c.expected == "advance" || c.expected == "promote";
+    c.regression = positive && c.actual != c.expected;
     const std::string reason = present && ac[c.cell].contains("reason") && ac[c.cell]["reason"].is_string()
                                    ? ac[c.cell]["reason"].get<std::string>()
                                    : std::string();
-    const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (c.actual == "pass" ? "improved" : "changed");
+    const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (c.actual == "pass" || c.actual == "advance" || c.actual == "promote" ? "improved" : "changed");
     c.line = std::string(tag) + " " + c.cell + ": expected " + c.expected + ", got " + c.actual +
              (reason.empty() ? "" : " (" + reason + ")");
     out.push_back(std::move(c));
@@ -418,6 +421,74 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
     out.push_back(std::move(c));
   }
   return out;
+}
+
+
+json promotion_report(const std::vector<EpisodeRecord>& records, const std::string& candidate, const std::string& baseline,
+                      std::size_t samples, std::uint64_t seed) {
+  // group by (task, split, backbone); keep cells where both methods ran
+  std::map<std::string, std::pair<std::vector<EpisodeRecord>, std::vector<EpisodeRecord>>> cells;
+  for (const auto& r : records) {
+    if (r.method != candidate && r.method != baseline) continue;
+    const std::string key = r.task + "/" + r.split + (r.backbone == "expert" ? "" : "/" + r.backbone);
+    (r.method == candidate ? cells[key].first : cells[key].second).push_back(r);
+  }
+  json j = {{"schema_version", "1.0"},
+            {"gate", "promotion"},
+            {"candidate", candidate},
+            {"baseline", baseline},
+            {"rules",
+             {{"min_gain", kPromotionMinGain},
+              {"prune_below_one_seed", kPruneSuccessFloor},
+              {"safety_regression_tolerance", kSafetyRegressionTolerance},
+              {"order", "prune (one seed < 0.3), reject on a safety regression, extend_seeds (< 3 matched seeds), "
+                        "promote on >= 5 points with the paired 95 % interval above 0 or on a Pareto point "
+                        "(fewer mean probe steps, paired success estimate >= 0), else reject"}}},
+            {"bootstrap", {{"samples", samples}, {"seed", seed}}},
+            {"cells", json::object()}};
+  for (const auto& [key, pair] : cells) {
+    if (pair.first.empty() || pair.second.empty()) continue;
+    const PromotionVerdict v = promotion_verdict(pair.first, pair.second, samples, seed);
+    j["cells"][key] = {{"task", pair.first.front().task},
+                       {"split", pair.first.front().split},
+                       {"backbone", pair.first.front().backbone},
+                       {"verdict", v.decision},
+                       {"reason", v.reason},
+                       {"matched_seeds", v.matched_seeds},
+                       {"candidate_success", v.candidate_rate},
+                       {"baseline_success", v.baseline_rate},
+                       {"difference", bootstrap_json(v.difference)},
+                       {"candidate_probe_steps", v.candidate_probe_steps},
+                       {"baseline_probe_steps", v.baseline_probe_steps},
+                       {"candidate_flag_rate", v.candidate_flag_rate},
+                       {"baseline_flag_rate", v.baseline_flag_rate},
+                       {"five_point_rule", v.five_point_rule},
+                       {"pareto_rule", v.pareto_rule},
+                       {"safety_regression", v.safety_regression}};
+  }
+  return j;
+}
+
+std::string promotion_to_markdown(const json& report) {
+  std::ostringstream o;
+  o << "Promotion: " << report["candidate"].get<std::string>() << " vs " << report["baseline"].get<std::string>() << "\n\n"
+    << "| cell | candidate | baseline | difference [95 % CI] | probe steps (cand / base) | seeds | verdict | reason |\n"
+    << "|---|---:|---:|---|---|---:|---|---|\n";
+  auto f3 = [](double x) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(3) << x;
+    return s.str();
+  };
+  for (auto it = report["cells"].begin(); it != report["cells"].end(); ++it) {
+    const json& c = it.value();
+    const json& d = c["difference"];
+    o << "| " << it.key() << " | " << f3(c["candidate_success"].get<double>()) << " | " << f3(c["baseline_success"].get<double>())
+      << " | " << f3(d["estimate"].get<double>()) << " [" << f3(d["lower"].get<double>()) << ", " << f3(d["upper"].get<double>())
+      << "] | " << f3(c["candidate_probe_steps"].get<double>()) << " / " << f3(c["baseline_probe_steps"].get<double>()) << " | "
+      << c["matched_seeds"].get<std::size_t>() << " | **" << c["verdict"].get<std::string>() << "** | "
+      << c["reason"].get<std::string>() << " |\n";
+  }
+  return o.str();
 }
 
 }  // namespace actionshift::eval

@@ -11,6 +11,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -195,7 +196,20 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     throw InputError(at_line(source, root["episodes"]), "episodes", "expected a positive integer (got " + yaml_text(root["episodes"]) + ")");
   ex.episodes = *episodes;
   ex.backbone = require_string(root["backbone"], source, "backbone");
-  if (root["pool"] && !root["pool"].IsNull()) ex.pool = require_token(root["pool"], source, "pool");
+  if (root["pool"] && root["pool"].IsMap()) {
+    for (const auto& kv : root["pool"]) {
+      const std::string split = kv.first.as<std::string>();
+      if (std::find(ex.splits.begin(), ex.splits.end(), split) == ex.splits.end())
+        throw InputError(at_line(source, kv.first), "pool." + split, "names a split that is not in splits");
+      ex.split_pools[split] = kv.second.IsNull() ? std::nullopt
+                                                 : std::optional<std::string>(require_token(kv.second, source, "pool." + split));
+    }
+    for (const auto& split : ex.splits)
+      if (!ex.split_pools.count(split))
+        throw InputError(at_line(source, root["pool"]), "pool." + split, "missing (a per-split pool map must name every split)");
+  } else if (root["pool"] && !root["pool"].IsNull()) {
+    ex.pool = require_token(root["pool"], source, "pool");
+  }
   if (root["rotation_mode"]) {
     ex.rotation_mode = require_string(root["rotation_mode"], source, "rotation_mode");
     if (ex.rotation_mode != "live" && ex.rotation_mode != "identity")
@@ -215,9 +229,9 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.task = q.task;
   job.split = resolver.split(q.task, q.split);
   job.method = q.method.name;
-  job.method_params = q.method.params;
+  job.method_params = resolver.method_params ? resolver.method_params(q.method) : q.method.params;
   job.backbone = resolver.backbone(q.task, q.backbone);
-  if (q.pool) job.pool = resolver.pool(*q.pool);
+  if (q.pool && (!resolver.method_uses_pool || resolver.method_uses_pool(q.method))) job.pool = resolver.pool(*q.pool);
   job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, q.method) : std::nullopt;
   job.rotation_mode = q.rotation_mode;
   job.seed = q.seed;
@@ -233,8 +247,13 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
   plan.experiment = ex.name;
   plan.source = ex.source;
   plan.source_sha256 = ex.source_sha256;
-  std::optional<PoolRef> pool;
-  if (ex.pool) pool = resolver.pool(*ex.pool);
+  std::map<std::string, std::optional<PoolRef>> pools;  // by split
+  for (const auto& split_name : ex.splits) {
+    const auto it = ex.split_pools.find(split_name);
+    const std::optional<std::string> name = it != ex.split_pools.end() ? it->second : ex.pool;
+    if (name && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");
+    pools[split_name] = name ? std::optional<PoolRef>(resolver.pool(*name)) : std::nullopt;
+  }
   if (resolver.check_method)
     for (const auto& m : ex.methods) resolver.check_method(m);
   std::set<std::string> ids;
@@ -251,9 +270,9 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
           pj.spec.task = task;
           pj.spec.split = split;
           pj.spec.method = method.name;
-          pj.spec.method_params = method.params;
+          pj.spec.method_params = resolver.method_params ? resolver.method_params(method) : method.params;
           pj.spec.backbone = backbone;
-          pj.spec.pool = pool;
+          if (!resolver.method_uses_pool || resolver.method_uses_pool(method)) pj.spec.pool = pools[split_name];
           pj.spec.calibration_sha256 = calibration;
           pj.spec.rotation_mode = ex.rotation_mode;
           pj.spec.seed = seed;

@@ -176,3 +176,33 @@ TEST(Plan, SlurmArrayScript) {
 
 }  // namespace
 }  // namespace actionshift::eval
+
+namespace actionshift::eval {
+namespace {
+
+TEST(Plan, PerSplitPoolsAndMethodsWithoutAPool) {
+  const std::string yaml =
+      "name: t\ntasks: [pick_cube]\nsplits: [reference_seen, seen]\nmethods: [oracle, fixed_probes]\n"
+      "seeds: [1]\nepisodes: 4\nbackbone: expert\npool: {reference_seen: reference9, seen: full}\n";
+  const Experiment ex = parse_experiment(yaml, "t.yaml");
+  ASSERT_EQ(ex.split_pools.size(), 2u);
+  EXPECT_EQ(*ex.split_pools.at("seen"), "full");
+  PlanResolver r;
+  r.split = [](const std::string&, const std::string& s) { return SplitRef{s, sha256_hex(s), 2}; };
+  r.backbone = [](const std::string&, const std::string& b) { return BackboneRef{b, sha256_hex(b)}; };
+  r.pool = [](const std::string& p) { return PoolRef{p, sha256_hex("pool:" + p)}; };
+  r.method_uses_pool = [](const MethodEntry& m) { return m.name != "oracle"; };
+  const Plan plan = make_plan(ex, r);
+  ASSERT_EQ(plan.jobs.size(), 4u);
+  EXPECT_FALSE(plan.jobs[0].spec.pool);  // reference_seen, oracle
+  EXPECT_EQ(plan.jobs[1].spec.pool->name, "reference9");  // reference_seen, fixed_probes
+  EXPECT_FALSE(plan.jobs[2].spec.pool);
+  EXPECT_EQ(plan.jobs[3].spec.pool->name, "full");
+  EXPECT_THAT([&] { parse_experiment(yaml.substr(0, yaml.find("pool:")) + "pool: {seen: full}\n", "t.yaml"); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("pool.reference_seen: missing")));
+  EXPECT_THAT([&] { parse_experiment(yaml.substr(0, yaml.find("pool:")) + "pool: {reference_seen: a, seen: b, other: c}\n", "t.yaml"); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("pool.other: names a split that is not in splits")));
+}
+
+}  // namespace
+}  // namespace actionshift::eval

@@ -34,6 +34,14 @@ Pose6 tcp_response(std::span<const double> prev_obs, std::span<const double> cur
 /// Orientation matrix of the TCP in an observation (the frame rotation adapters feed to decoders).
 Mat3 tcp_rotation(std::span<const double> obs, const TcpSlice& slice);
 
+inline std::span<const double> as_span(const Eigen::VectorXd& v) {
+  return {v.data(), static_cast<std::size_t>(v.size())};
+}
+inline Pose6 tcp_response(const Eigen::VectorXd& prev, const Eigen::VectorXd& cur, const TcpSlice& slice) {
+  return tcp_response(as_span(prev), as_span(cur), slice);
+}
+inline Mat3 tcp_rotation(const Eigen::VectorXd& obs, const TcpSlice& slice) { return tcp_rotation(as_span(obs), slice); }
+
 /// Calibrated per-channel Gaussian response model.
 struct ResponseModel {
   std::array<double, kPoseDim> alpha{1, 1, 1, 1, 1, 1};  ///< response per unit canonical command (m or rad)

@@ -183,6 +183,15 @@ PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate,
                                    const std::vector<EpisodeRecord>& baseline,
                                    std::size_t samples = kBootstrapSamples, std::uint64_t seed = kBootstrapSeed);
 
+/// Promotion verdicts of `candidate` against `baseline` for every (task, split, backbone) cell of
+/// `records` holding both methods: the verdict file {"gate":"promotion","candidate","baseline",
+/// "cells":{"<task>/<split>":{"verdict","reason",...evidence}}} (comparable with gate check).
+nlohmann::json promotion_report(const std::vector<EpisodeRecord>& records, const std::string& candidate,
+                                const std::string& baseline, std::size_t samples = kBootstrapSamples,
+                                std::uint64_t seed = kBootstrapSeed);
+/// Markdown table of a promotion report.
+std::string promotion_to_markdown(const nlohmann::json& report);
+
 // ---------------------------------------------------------------------------------------------
 // Verdict files
 
@@ -191,7 +200,7 @@ struct VerdictChange {
   std::string cell;       ///< cell key, e.g. "pick_cube/seen"
   std::string expected;   ///< expected verdict
   std::string actual;     ///< recomputed verdict ("missing" if absent)
-  bool regression{false}; ///< expected "pass", actual anything else
+  bool regression{false}; ///< expected a positive verdict ("pass", "advance", "promote"), actual anything else
   std::string line;       ///< one printable line
 };
 

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -37,6 +38,8 @@ struct Experiment {
   std::int64_t episodes{0};           ///< episodes per (task, split, method, seed) job
   std::string backbone;               ///< backbone name
   std::optional<std::string> pool;    ///< pool name, or none
+  /// Per-split pools (YAML `pool: {split: pool, ...}`, every split named); overrides `pool`.
+  std::map<std::string, std::optional<std::string>> split_pools;
   std::string rotation_mode{"live"};  ///< "live" or "identity"
 };
 
@@ -57,6 +60,12 @@ struct PlanResolver {
   std::function<PoolRef(const std::string& pool)> pool;
   std::function<std::optional<std::string>(const std::string& task, const MethodEntry& method)> calibration;
   std::function<void(const MethodEntry& method)> check_method;
+  /// If set: the method's parameters as they enter the job spec (e.g. with defaults filled in, so
+  /// a changed default changes the job id). Unset: the parameters as written.
+  std::function<std::string(const MethodEntry& method)> method_params;
+  /// If set: whether a method takes the experiment's pool (false: its jobs get no pool, so e.g. an
+  /// oracle job has the same id with or without a pool in the experiment). Unset: every method does.
+  std::function<bool(const MethodEntry& method)> method_uses_pool;
 };
 
 /// A single job by names, as on the `actionshift run --task T --split S --method M ...` command line.
