@@ -58,7 +58,9 @@ IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::Vec
   for (int it = 1; it <= options.max_iterations && best.error >= options.tolerance; ++it) {
     Eigen::Matrix<double, 6, 6> a = best_jac * best_jac.transpose();
     a.diagonal().array() += lambda;
-    ChainVector dq = best_jac.transpose() * a.ldlt().solve(best_err);
+    const Eigen::Matrix<double, 6, 1> y = a.ldlt().solve(best_err);
+    ChainVector dq = ChainVector::Zero(chain.dof());
+    dq.noalias() += best_jac.transpose() * y;
     const double biggest = dq.cwiseAbs().maxCoeff();
     if (biggest > options.max_step) dq *= options.max_step / biggest;
     const ChainVector q = (best.q + dq).cwiseMax(chain.lower()).cwiseMin(chain.upper());
