@@ -1,6 +1,7 @@
 // The actionshift command-line tool: the only translation unit that includes CLI11.
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
+#include "cmd_policy.hpp"
 #include "commands.hpp"
 
 #include <CLI/CLI.hpp>
@@ -80,6 +81,41 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
   bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
+
+  // ---- train bc | gate0 (policy layer)
+  auto* train = app.add_subcommand("train", "Train backbones");
+  train->require_subcommand(1);
+  cli::TrainBcOptions train_o;
+  auto* bc = train->add_subcommand(
+      "bc", "Train the MLP backbone of a task by DAgger from the scripted expert (Eigen, Adam; seeded and\n"
+            "deterministic). Writes configs/backbones/<task>.mlp[-delay-aware].asmlp (docs/backbones.md).");
+  bc->add_option("--task", train_o.task, "pick_cube, push_cube, pull_cube, stack_cube")->required();
+  bc->add_flag("--delay-aware", train_o.delay_aware, "Append the last 4 actions to the input; train under random lag {0,1,2,4}");
+  bc->add_option("--seed", train_o.seed, "Seed")->capture_default_str();
+  bc->add_option("--iterations", train_o.iterations, "DAgger iterations (the first rolls out the expert)")->capture_default_str();
+  bc->add_option("--episodes", train_o.episodes, "Episodes per iteration")->capture_default_str();
+  bc->add_option("--steps", train_o.steps, "Adam steps per iteration")->capture_default_str();
+  bc->add_option("--threads", train_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
+  bc->add_option("--out", train_o.out, "Weight file (default: configs/backbones/<task>.<backbone>.asmlp)");
+  bc->callback([&] { action = [&] { return cli::run_train_bc(train_o); }; });
+  cli::Gate0Options gate0_o;
+  auto* gate0 = app.add_subcommand(
+      "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"
+               "parity (identity-wrapped vs unwrapped, same initial states); decision advance or exclude (exit 1).\n"
+               "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<file>, external:<command>.");
+  gate0->add_option("--backbone", gate0_o.backbone, "Backbone")->capture_default_str();
+  gate0->add_option("--task", gate0_o.task, "Task")->required();
+  gate0->add_option("--episodes", gate0_o.episodes, "Episodes (each run unwrapped and identity-wrapped)")->capture_default_str();
+  gate0->add_option("--seed", gate0_o.seed, "Experimental seed")->capture_default_str();
+  gate0->add_option("--floor", gate0_o.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)");
+  gate0->add_option("--rule", gate0_o.rule, "Competence statistic: wilson_lower or point_estimate")->capture_default_str();
+  gate0->add_option("--threads", gate0_o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  gate0->add_flag("--json", gate0_o.json, "Print the verdict file instead of text");
+  gate0->add_option("--out", gate0_o.out, "Write the verdict file here");
+  gate0->add_option("--backbones-dir", gate0_o.backbones_dir, "Directory of the MLP weight files");
+  gate0->add_option("--step-timeout", gate0_o.step_timeout_s, "Seconds an external policy may take per step")->capture_default_str();
+  gate0->add_flag("--progress,!--quiet", gate0_o.progress, "No progress on stderr");
+  gate0->callback([&] { action = [&] { return cli::run_gate0(gate0_o); }; });
 
   try {
     app.parse(argc, argv);

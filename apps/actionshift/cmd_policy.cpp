@@ -1,0 +1,144 @@
+// `train bc` and `gate0`: thin wrappers over the policy layer
+#include "cmd_policy.hpp"
+
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/policy/gate0.hpp"
+#include "actionshift/policy/registry.hpp"
+#include "actionshift/policy/train.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace actionshift::cli {
+namespace {
+
+std::string fmt(double x, int digits = 3) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << x;
+  return s.str();
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::trunc);
+    if (!f) throw InputError(path, "", "cannot write");
+    f << text;
+    if (!f) throw InputError(path, "", "write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError(path, "", "cannot rename temporary file");
+}
+
+}  // namespace
+
+int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) {
+  try {
+    policy::TrainBcOptions t;
+    t.task = sim::parse_task(o.task);
+    t.delay_aware = o.delay_aware;
+    t.seed = o.seed;
+    t.iterations = o.iterations;
+    t.episodes_per_iteration = o.episodes;
+    t.steps_per_iteration = o.steps;
+    t.threads = o.threads;
+    if (o.iterations <= 0 || o.episodes <= 0 || o.steps < 0)
+      throw InputError("", "train bc", "--iterations and --episodes must be positive, --steps non-negative");
+    const std::string backbone = o.delay_aware ? "mlp-delay-aware" : "mlp";
+    const std::string path = o.out.empty() ? policy::mlp_weights_path(backbone, t.task) : o.out;
+    std::string command = "actionshift train bc --task " + o.task + (o.delay_aware ? " --delay-aware" : "") +
+                          " --seed " + std::to_string(o.seed) + " --iterations " + std::to_string(o.iterations) +
+                          " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps);
+    err << "train bc: " << o.task << " " << backbone << ", layers " << sim::observation_layout(t.task).size() +
+                                                                            (o.delay_aware ? 28 : 0)
+        << "-256-256-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
+    auto result = policy::train_bc(t, [&err, &o](const policy::TrainIteration& it) {
+      err << "  iteration " << it.iteration + 1 << "/" << o.iterations << ": beta " << fmt(it.beta, 3) << ", rollouts "
+          << it.successes << "/" << it.episodes << " success, data " << it.samples << ", loss " << fmt(it.loss, 5)
+          << ", " << fmt(it.seconds, 1) << " s\n";
+    });
+    result.weights.training = {{"command", command},
+                               {"seed", o.seed},
+                               {"algorithm", "DAgger from the scripted expert, Adam, MSE (gripper weight 2)"},
+                               {"iterations", o.iterations},
+                               {"episodes_per_iteration", o.episodes},
+                               {"steps_per_iteration", o.steps},
+                               {"batch_size", t.batch_size},
+                               {"learning_rate", t.learning_rate},
+                               {"teacher", o.delay_aware ? "expert-delay-aware (true lag)" : "expert"},
+                               {"lags", o.delay_aware ? nlohmann::json({0, 1, 2, 4}) : nlohmann::json({0})},
+                               {"final_rollout_success", result.iterations.back().successes},
+                               {"final_rollout_episodes", result.iterations.back().episodes}};
+    policy::save_mlp(result.weights, path);
+    const std::string bytes = policy::serialize_mlp(result.weights);
+    out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.weights.parameter_count()
+        << " parameters, sha256 " << sha256_hex(bytes) << ") in " << fmt(result.wall_seconds, 1) << " s\n";
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
+  std::unique_ptr<policy::Policy> pol;
+  policy::Gate0Run run;
+  try {
+    const sim::TaskId task = sim::parse_task(o.task);
+    if (o.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
+    run.episodes = o.episodes;
+    run.seed = o.seed;
+    run.floor = o.floor;
+    run.rule = policy::parse_gate0_rule(o.rule);
+    run.threads = o.threads;
+    policy::RegistryOptions reg;
+    reg.backbones_dir = o.backbones_dir;
+    reg.external.step_timeout_s = o.step_timeout_s;
+    pol = policy::make_policy(o.backbone, task, reg);
+  } catch (const std::invalid_argument& e) {
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::runtime_error& e) {
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  }
+  if (o.progress) {
+    run.progress = [&err, last = std::int64_t{-1}](std::int64_t k, std::int64_t n) mutable {
+      const std::int64_t pct = 100 * k / n;
+      if (pct / 10 != last / 10 || k == n) {
+        err << "\rgate0: " << k << "/" << n << " episodes (" << pct << " %)" << (k == n ? "\n" : "") << std::flush;
+        last = pct;
+      }
+    };
+  }
+  policy::Gate0Verdict v;
+  try {
+    v = policy::run_gate0(*pol, run);
+  } catch (const std::exception& e) {
+    if (o.progress) err << "\n";
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  }
+  const nlohmann::json j = policy::gate0_to_json({v});
+  if (!o.out.empty()) write_file_atomic(o.out, j.dump(2) + "\n");
+  if (o.json) {
+    out << j.dump(2) << "\n";
+  } else {
+    const auto& c = v.competence;
+    const auto& p = v.identity_parity;
+    out << "Gate 0: " << v.backbone << " on " << v.task << " (" << v.episodes << " episodes, seed " << v.seed << ")\n"
+        << "  competence: success_once " << c.interval.successes << "/" << c.interval.total << " = " << fmt(c.interval.rate)
+        << " [" << fmt(c.interval.lower) << ", " << fmt(c.interval.upper) << "], floor " << fmt(c.floor, 2) << " ("
+        << policy::gate0_rule_name(c.rule) << "): " << (c.passed ? "pass" : "fail") << "\n"
+        << "  parity: identity-wrapped " << p.wrapped.successes << "/" << p.wrapped.total << " = " << fmt(p.wrapped.rate)
+        << " [" << fmt(p.wrapped.lower) << ", " << fmt(p.wrapped.upper) << "], |diff| " << fmt(p.absolute_difference, 4)
+        << "; two-point rule " << (p.two_point_rule ? "pass" : "fail") << ", overlap rule "
+        << (p.overlap_rule ? "pass" : "fail") << ": " << (p.passed ? "pass" : "fail") << "\n"
+        << "  decision: " << v.decision << (v.reason.empty() ? "" : " (" + v.reason + ")") << "\n";
+  }
+  return v.passed ? 0 : 1;
+}
+
+}  // namespace actionshift::cli

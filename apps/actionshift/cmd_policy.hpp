@@ -1,0 +1,43 @@
+#pragma once
+// Policy subcommands of the actionshift CLI as plain functions (no CLI11 here): main.cpp maps parsed
+// options onto these structs. Each returns 0 ok, 1 check failed (Gate 0 "exclude"), 2 bad input.
+
+#include <cstdint>
+#include <iostream>
+#include <string>
+
+namespace actionshift::cli {
+
+// `actionshift train bc --task T [--delay-aware] [--seed S] [--iterations N] [--episodes N]
+//  [--steps N] [--threads N] [--out FILE]`
+struct TrainBcOptions {
+  std::string task;                 // --task
+  bool delay_aware{false};          // --delay-aware: history of 4 actions, random lag {0,1,2,4}
+  std::uint64_t seed{20260718};     // --seed
+  int iterations{8};                // --iterations (DAgger iterations, the first is the expert's)
+  int episodes{64};                 // --episodes per iteration
+  int steps{1500};                  // --steps Adam steps per iteration
+  unsigned threads{0};              // --threads for data collection (0: all cores)
+  std::string out;                  // --out FILE ("" → configs/backbones/<task>.mlp[-delay-aware].asmlp)
+};
+int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+
+// `actionshift gate0 --backbone B --task T --episodes N [--seed S] [--floor F] [--rule R]
+//  [--threads N] [--json] [--out FILE] [--backbones-dir DIR] [--step-timeout S]`
+struct Gate0Options {
+  std::string backbone{"expert"};   // --backbone
+  std::string task;                 // --task
+  std::int64_t episodes{300};       // --episodes
+  std::uint64_t seed{20260718};     // --seed
+  double floor{-1.0};               // --floor (< 0: the task's reference floor)
+  std::string rule{"wilson_lower"}; // --rule wilson_lower|point_estimate
+  unsigned threads{0};              // --threads (0: all cores)
+  bool json{false};                 // --json: print the verdict file instead of text
+  std::string out;                  // --out FILE: write the verdict file
+  std::string backbones_dir;        // --backbones-dir ("" → default)
+  double step_timeout_s{10.0};      // --step-timeout (external policies)
+  bool progress{true};              // progress on stderr (off with --quiet)
+};
+int run_gate0(const Gate0Options& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+
+}  // namespace actionshift::cli

@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// A policy implemented by another process, in any language, speaking JSON lines over its stdin and
+/// stdout (protocol "actionshift-policy-v1", docs/backbones.md; example:
+/// docs/examples/external_policy.py). One object per line, UTF-8, '\n'-terminated:
+///
+///   -> {"type":"hello","protocol":"actionshift-policy-v1","task":"pick_cube","obs_dim":42,
+///       "action_dim":7,"horizon":50,"control_dt_s":0.05,"layout":{"size":42,"fields":[...]}}
+///   <- {"type":"ready"}                                  (within the hello timeout)
+///   -> {"type":"reset","episode":0,"task":...,"layout":{...}}      (episode start; no reply)
+///   -> {"type":"step","t":0,"obs":[42 numbers]}
+///   <- {"action":[7 numbers]}                            (within the step timeout)
+///   ...
+///   (end: stdin is closed; the process should exit; it is killed after 2 s)
+///
+/// The command runs under `/bin/sh -c`; its stderr is passed through. The process is started
+/// when the policy is constructed (one process per clone, so one per worker thread). A process
+/// that exits, closes stdout, exceeds the timeout, or replies with anything but a JSON object with
+/// a 7-number finite "action" array makes act() throw std::runtime_error naming the command, the
+/// step and the reason; nothing hangs. SIGPIPE is ignored process-wide once an external policy is
+/// created (writes to a dead process then fail with EPIPE instead of killing the caller).
+
+#include "actionshift/policy/policy.hpp"
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+namespace actionshift::policy {
+
+/// Protocol identifier sent in the hello message.
+inline constexpr std::string_view kExternalProtocol = "actionshift-policy-v1";
+
+/// Timeouts of the external-process protocol.
+struct ExternalOptions {
+  double hello_timeout_s{30.0};  ///< process start-up until the "ready" reply
+  double step_timeout_s{10.0};   ///< one step request until its reply
+};
+
+/// The external-process policy (name "external:<command>", sha256 = SHA-256 of the command string).
+class ExternalPolicy final : public Policy {
+ public:
+  /// Starts the process and performs the hello handshake. Throws std::runtime_error if the process
+  /// cannot be started or does not answer the hello correctly in time.
+  ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options = {});
+  ~ExternalPolicy() override;
+  ExternalPolicy(const ExternalPolicy&) = delete;
+  ExternalPolicy& operator=(const ExternalPolicy&) = delete;
+
+  void reset() override;
+  Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override;
+  std::string name() const override { return "external:" + command_; }
+  std::string sha256() const override;
+  sim::TaskId task() const override { return task_; }
+  std::unique_ptr<Policy> clone() const override;
+
+ private:
+  struct Process;
+  void send(const std::string& line, const char* what);
+  std::string receive(double timeout_s, const char* what);
+  [[noreturn]] void fail(const std::string& what, const std::string& reason);
+
+  std::string command_;
+  sim::TaskId task_;
+  ExternalOptions options_;
+  std::unique_ptr<Process> proc_;
+  std::int64_t episode_{-1};
+  int step_{0};
+};
+
+}  // namespace actionshift::policy

@@ -1,0 +1,198 @@
+// external-process policy: JSON lines over a child's stdin/stdout with timeouts
+#include "actionshift/policy/external.hpp"
+
+#include "actionshift/core/hash.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <mutex>
+#include <poll.h>
+#include <spawn.h>
+#include <stdexcept>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace actionshift::policy {
+
+struct ExternalPolicy::Process {
+  pid_t pid{-1};
+  int to_child{-1};    // child's stdin
+  int from_child{-1};  // child's stdout
+  std::string buffer;  // bytes read past the last complete line
+  bool exited{false};
+  int status{0};
+
+  // reap without blocking; true if the child has exited
+  bool poll_exit() {
+    if (exited) return true;
+    if (pid > 0 && waitpid(pid, &status, WNOHANG) == pid) exited = true;
+    return exited;
+  }
+  std::string exit_text() const {
+    if (WIFEXITED(status)) return "process exited with status " + std::to_string(WEXITSTATUS(status));
+    if (WIFSIGNALED(status)) return "process killed by signal " + std::to_string(WTERMSIG(status));
+    return "process ended";
+  }
+  ~Process() {
+    if (to_child >= 0) close(to_child);
+    if (from_child >= 0) close(from_child);
+    if (pid <= 0 || exited) return;
+    // give it up to 2 s to exit after stdin is closed, then kill
+    for (int i = 0; i < 200 && !poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!exited) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+    }
+  }
+};
+
+namespace {
+std::string excerpt(const std::string& s) {
+  std::string e = s.size() > 80 ? s.substr(0, 80) + "..." : s;
+  for (char& c : e)
+    if (c == '\n' || c == '\r') c = ' ';
+  return e;
+}
+}  // namespace
+
+ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options)
+    : command_(std::move(command)), task_(task), options_(options), proc_(std::make_unique<Process>()) {
+  if (command_.empty()) throw std::invalid_argument("external policy: empty command");
+  static std::once_flag ignore_sigpipe;
+  std::call_once(ignore_sigpipe, [] { std::signal(SIGPIPE, SIG_IGN); });
+  int in_pipe[2], out_pipe[2];
+  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw std::runtime_error("external policy: pipe failed");
+  if (pipe2(out_pipe, O_CLOEXEC) != 0) {
+    close(in_pipe[0]);
+    close(in_pipe[1]);
+    throw std::runtime_error("external policy: pipe failed");
+  }
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, in_pipe[0], STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&fa, out_pipe[1], STDOUT_FILENO);
+  std::string sh = "sh", dash_c = "-c";
+  char* argv[] = {sh.data(), dash_c.data(), command_.data(), nullptr};
+  const int rc = posix_spawn(&proc_->pid, "/bin/sh", &fa, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&fa);
+  close(in_pipe[0]);
+  close(out_pipe[1]);
+  proc_->to_child = in_pipe[1];
+  proc_->from_child = out_pipe[0];
+  if (rc != 0) {
+    proc_->pid = -1;
+    fail("start", std::strerror(rc));
+  }
+  const sim::ObservationLayout& layout = sim::observation_layout(task_);
+  nlohmann::json hello = {{"type", "hello"},
+                          {"protocol", std::string(kExternalProtocol)},
+                          {"task", std::string(sim::task_name(task_))},
+                          {"obs_dim", layout.size()},
+                          {"action_dim", kActionDim},
+                          {"horizon", sim::task_horizon(task_)},
+                          {"control_dt_s", 0.05},
+                          {"layout", nlohmann::json::parse(layout.to_json())}};
+  send(hello.dump(), "hello");
+  const std::string reply = receive(options_.hello_timeout_s, "hello");
+  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("type") || j.at("type") != "ready")
+    fail("hello", "expected {\"type\":\"ready\"}, got '" + excerpt(reply) + "'");
+}
+
+ExternalPolicy::~ExternalPolicy() = default;
+
+std::string ExternalPolicy::sha256() const { return sha256_hex(command_); }
+
+std::unique_ptr<Policy> ExternalPolicy::clone() const {
+  return std::make_unique<ExternalPolicy>(command_, task_, options_);
+}
+
+void ExternalPolicy::fail(const std::string& what, const std::string& reason) {
+  throw std::runtime_error("external policy '" + command_ + "': " + what + ": " + reason);
+}
+
+void ExternalPolicy::send(const std::string& line, const char* what) {
+  std::string data = line + "\n";
+  std::size_t off = 0;
+  while (off < data.size()) {
+    const ssize_t n = write(proc_->to_child, data.data() + off, data.size() - off);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (proc_->poll_exit()) fail(what, proc_->exit_text());
+      fail(what, std::string("write failed: ") + std::strerror(errno));
+    }
+    off += static_cast<std::size_t>(n);
+  }
+}
+
+std::string ExternalPolicy::receive(double timeout_s, const char* what) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (true) {
+    const auto nl = proc_->buffer.find('\n');
+    if (nl != std::string::npos) {
+      std::string line = proc_->buffer.substr(0, nl);
+      proc_->buffer.erase(0, nl + 1);
+      return line;
+    }
+    if (proc_->buffer.size() > (1u << 20)) fail(what, "reply line longer than 1 MiB");
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) fail(what, "no reply within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
+    pollfd p{proc_->from_child, POLLIN, 0};
+    const int r = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 100)));
+    if (r < 0 && errno != EINTR) fail(what, std::string("poll failed: ") + std::strerror(errno));
+    if (r <= 0) continue;
+    char chunk[4096];
+    const ssize_t n = read(proc_->from_child, chunk, sizeof chunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      // end of stream: the process closed stdout or died; wait briefly for its status
+      for (int i = 0; i < 50 && !proc_->poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      fail(what, proc_->exited ? proc_->exit_text() + " before replying" : std::string("process closed its stdout"));
+    }
+    proc_->buffer.append(chunk, static_cast<std::size_t>(n));
+  }
+}
+
+void ExternalPolicy::reset() {
+  ++episode_;
+  step_ = 0;
+  const sim::ObservationLayout& layout = sim::observation_layout(task_);
+  nlohmann::json msg = {{"type", "reset"},
+                        {"episode", episode_},
+                        {"task", std::string(sim::task_name(task_))},
+                        {"layout", nlohmann::json::parse(layout.to_json())}};
+  send(msg.dump(), "reset");
+}
+
+Action ExternalPolicy::act(const Eigen::Ref<const Eigen::VectorXd>& obs) {
+  check_observation(obs, task_);
+  const std::string what = "step " + std::to_string(step_);
+  nlohmann::json msg = {{"type", "step"}, {"t", step_}, {"obs", std::vector<double>(obs.data(), obs.data() + obs.size())}};
+  send(msg.dump(), what.c_str());
+  const std::string reply = receive(options_.step_timeout_s, what.c_str());
+  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
+  auto garbage = [&](const std::string& why) { fail(what, "bad reply (" + why + "): '" + excerpt(reply) + "'"); };
+  if (j.is_discarded()) garbage("not JSON");
+  if (!j.is_object() || !j.contains("action")) garbage("expected {\"action\": [7 numbers]}");
+  const nlohmann::json& a = j.at("action");
+  if (!a.is_array() || a.size() != static_cast<std::size_t>(kActionDim)) garbage("action must be an array of 7 numbers");
+  Action out;
+  for (int i = 0; i < kActionDim; ++i) {
+    const nlohmann::json& v = a.at(static_cast<std::size_t>(i));
+    if (!v.is_number()) garbage("action must be an array of 7 numbers");
+    out(i) = v.get<double>();
+    if (!std::isfinite(out(i))) garbage("non-finite action");
+  }
+  ++step_;
+  return out;
+}
+
+}  // namespace actionshift::policy

@@ -1,0 +1,251 @@
+// MLP backbone: weight file format, forward pass, policy
+#include "actionshift/policy/mlp.hpp"
+
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/core/rng.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+
+namespace actionshift::policy {
+namespace {
+
+constexpr char kMagic[8] = {'A', 'S', 'M', 'L', 'P', 'W', '\0', '\1'};
+constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kMaxHeaderBytes = 1u << 20;
+constexpr int kMaxLayerWidth = 4096;
+
+static_assert(std::endian::native == std::endian::little, "the .asmlp reader assumes a little-endian host");
+
+void put_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
+std::uint32_t get_u32(std::string_view s, std::size_t at) {
+  std::uint32_t v;
+  std::memcpy(&v, s.data() + at, 4);
+  return v;
+}
+
+std::string payload_bytes(const MlpWeights& w) {
+  std::string out;
+  auto put = [&out](const float* p, Eigen::Index n) { out.append(reinterpret_cast<const char*>(p), static_cast<std::size_t>(n) * 4); };
+  put(w.input_mean.data(), w.input_mean.size());
+  put(w.input_std.data(), w.input_std.size());
+  for (std::size_t i = 0; i < w.w.size(); ++i) {
+    // row-major W
+    const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = w.w[i];
+    put(rm.data(), rm.size());
+    put(w.b[i].data(), w.b[i].size());
+  }
+  return out;
+}
+
+std::int64_t payload_floats(const std::vector<int>& layers) {
+  return 2 * static_cast<std::int64_t>(layers.front()) + mlp_parameter_count(layers);
+}
+
+}  // namespace
+
+std::int64_t mlp_parameter_count(const std::vector<int>& layers) {
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i + 1 < layers.size(); ++i)
+    n += static_cast<std::int64_t>(layers[i]) * layers[i + 1] + layers[i + 1];
+  return n;
+}
+
+std::int64_t MlpWeights::parameter_count() const { return mlp_parameter_count(layers); }
+
+MlpWeights MlpWeights::init(sim::TaskId task, int history, const std::vector<int>& hidden, std::uint64_t seed) {
+  MlpWeights m;
+  m.task = task;
+  m.history = history;
+  m.layers.push_back(sim::observation_layout(task).size() + kActionDim * history);
+  for (int h : hidden) m.layers.push_back(h);
+  m.layers.push_back(kActionDim);
+  m.input_mean = Eigen::VectorXf::Zero(m.layers.front());
+  m.input_std = Eigen::VectorXf::Ones(m.layers.front());
+  Rng rng(seed);
+  for (std::size_t i = 0; i + 1 < m.layers.size(); ++i) {
+    const int in = m.layers[i], out = m.layers[i + 1];
+    const double limit = std::sqrt(6.0 / (in + out));
+    Eigen::MatrixXf w(out, in);
+    for (int r = 0; r < out; ++r)
+      for (int c = 0; c < in; ++c) w(r, c) = static_cast<float>(rng.uniform(-limit, limit));
+    m.w.push_back(w);
+    m.b.push_back(Eigen::VectorXf::Zero(out));
+  }
+  return m;
+}
+
+std::string serialize_mlp(const MlpWeights& w) {
+  const std::string payload = payload_bytes(w);
+  nlohmann::json h = {{"format", "actionshift-mlp"},
+                      {"version", kFormatVersion},
+                      {"task", std::string(sim::task_name(w.task))},
+                      {"obs_dim", sim::observation_layout(w.task).size()},
+                      {"history", w.history},
+                      {"input_dim", w.input_dim()},
+                      {"layers", w.layers},
+                      {"activation", "tanh"},
+                      {"output", "clip[-1,1]"},
+                      {"parameters", w.parameter_count()},
+                      {"payload_floats", payload.size() / 4},
+                      {"payload_sha256", sha256_hex(payload)},
+                      {"training", w.training}};
+  const std::string header = h.dump();
+  std::string out(kMagic, 8);
+  put_u32(out, kFormatVersion);
+  put_u32(out, static_cast<std::uint32_t>(header.size()));
+  out += header;
+  out += payload;
+  return out;
+}
+
+MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
+  auto fail = [&source](const std::string& field, const std::string& reason) -> InputError {
+    return InputError(source, field, reason);
+  };
+  if (bytes.size() < 16) throw fail("", "not an ActionShift MLP weight file (truncated: " + std::to_string(bytes.size()) + " bytes)");
+  if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("magic", "not an ActionShift MLP weight file (bad magic)");
+  const std::uint32_t version = get_u32(bytes, 8);
+  if (version != kFormatVersion)
+    throw fail("version", "unsupported format version " + std::to_string(version) + " (expected 1)");
+  const std::uint32_t hlen = get_u32(bytes, 12);
+  if (hlen > kMaxHeaderBytes || 16 + static_cast<std::size_t>(hlen) > bytes.size())
+    throw fail("header", "truncated file: header of " + std::to_string(hlen) + " bytes does not fit");
+  const nlohmann::json h = nlohmann::json::parse(bytes.substr(16, hlen), nullptr, false);
+  if (h.is_discarded() || !h.is_object()) throw fail("header", "header is not a JSON object");
+  auto need = [&](const char* key) -> const nlohmann::json& {
+    if (!h.contains(key)) throw fail(std::string("header.") + key, "missing");
+    return h.at(key);
+  };
+  MlpWeights w;
+  try {
+    if (need("format") != "actionshift-mlp") throw fail("header.format", "expected \"actionshift-mlp\"");
+    w.task = sim::parse_task(need("task").get<std::string>());
+    w.history = need("history").get<int>();
+    if (w.history != 0 && w.history != kHistoryLength)
+      throw fail("header.history", "must be 0 or " + std::to_string(kHistoryLength) + " (got " + std::to_string(w.history) + ")");
+    w.layers = need("layers").get<std::vector<int>>();
+    if (h.contains("training")) w.training = h.at("training");
+  } catch (const nlohmann::json::exception& e) {
+    throw fail("header", std::string("wrong field type: ") + e.what());
+  } catch (const InputError& e) {
+    if (e.source() == source) throw;
+    throw fail("header.task", e.reason());
+  }
+  // shapes must match the task's observation
+  const int obs_dim = sim::observation_layout(w.task).size();
+  const int expected_in = obs_dim + kActionDim * w.history;
+  if (w.layers.size() < 2) throw fail("header.layers", "needs at least an input and an output size");
+  for (int n : w.layers)
+    if (n <= 0 || n > kMaxLayerWidth) throw fail("header.layers", "layer size " + std::to_string(n) + " out of range [1, 4096]");
+  if (w.layers.front() != expected_in)
+    throw fail("header.layers", "input size " + std::to_string(w.layers.front()) + " does not match task " +
+                                    std::string(sim::task_name(w.task)) + " (expected " + std::to_string(expected_in) + ")");
+  if (w.layers.back() != kActionDim)
+    throw fail("header.layers", "output size " + std::to_string(w.layers.back()) + " (expected 7)");
+  const std::int64_t floats = payload_floats(w.layers);
+  const std::string_view payload = bytes.substr(16 + hlen);
+  if (static_cast<std::int64_t>(payload.size()) != floats * 4)
+    throw fail("payload", (static_cast<std::int64_t>(payload.size()) < floats * 4 ? "truncated: " : "trailing bytes: ") +
+                              std::to_string(payload.size()) + " bytes, expected " + std::to_string(floats * 4) +
+                              " for layers of the header");
+  if (h.contains("payload_sha256") && h.at("payload_sha256") != sha256_hex(payload))
+    throw fail("payload", "checksum mismatch (corrupt file)");
+  // read the arrays
+  std::size_t at = 0;
+  auto take = [&](float* dst, std::int64_t n) {
+    std::memcpy(dst, payload.data() + at, static_cast<std::size_t>(n) * 4);
+    at += static_cast<std::size_t>(n) * 4;
+  };
+  const int in = w.layers.front();
+  w.input_mean.resize(in);
+  w.input_std.resize(in);
+  take(w.input_mean.data(), in);
+  take(w.input_std.data(), in);
+  for (std::size_t i = 0; i + 1 < w.layers.size(); ++i) {
+    Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm(w.layers[i + 1], w.layers[i]);
+    take(rm.data(), rm.size());
+    w.w.emplace_back(rm);
+    Eigen::VectorXf b(w.layers[i + 1]);
+    take(b.data(), b.size());
+    w.b.push_back(b);
+  }
+  auto finite = [](const auto& m) { return m.allFinite(); };
+  bool ok = finite(w.input_mean) && finite(w.input_std) && (w.input_std.array() > 0.0f).all();
+  for (std::size_t i = 0; i < w.w.size(); ++i) ok = ok && finite(w.w[i]) && finite(w.b[i]);
+  if (!ok) throw fail("payload", "non-finite weight or non-positive input_std");
+  return w;
+}
+
+void save_mlp(const MlpWeights& w, const std::string& path) {
+  const std::string bytes = serialize_mlp(w);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error(path + ": cannot write");
+    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!f) throw std::runtime_error(path + ": write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename temporary file");
+}
+
+namespace {
+std::string read_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path, "", "cannot open weight file");
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+MlpWeights load_mlp(const std::string& path) { return parse_mlp(read_file(path), path); }
+
+Action mlp_forward(const MlpWeights& w, const Eigen::Ref<const Eigen::VectorXf>& x) {
+  Eigen::VectorXf h = (x - w.input_mean).cwiseQuotient(w.input_std);
+  for (std::size_t i = 0; i < w.w.size(); ++i) {
+    Eigen::VectorXf z = w.w[i] * h + w.b[i];
+    h = i + 1 < w.w.size() ? Eigen::VectorXf(z.array().tanh()) : z;
+  }
+  return h.cast<double>().cwiseMax(-1.0).cwiseMin(1.0);
+}
+
+MlpPolicy::MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha256)
+    : weights_(std::move(weights)), sha256_(std::move(sha256)) {
+  input_ = Eigen::VectorXf::Zero(weights_->input_dim());
+}
+
+std::unique_ptr<MlpPolicy> MlpPolicy::from_file(const std::string& path) {
+  const std::string bytes = read_file(path);
+  auto w = std::make_shared<const MlpWeights>(parse_mlp(bytes, path));
+  return std::make_unique<MlpPolicy>(std::move(w), sha256_hex(bytes));
+}
+
+void MlpPolicy::reset() { input_.setZero(); }
+
+Action MlpPolicy::act(const Eigen::Ref<const Eigen::VectorXd>& obs) {
+  check_observation(obs, weights_->task);
+  const int d = static_cast<int>(obs.size());
+  input_.head(d) = obs.cast<float>();
+  const Action a = mlp_forward(*weights_, input_);
+  if (weights_->history > 0) {
+    // shift the history one slot back and put this action first
+    const int h = weights_->history * kActionDim;
+    Eigen::VectorXf hist = input_.segment(d, h);
+    input_.segment(d + kActionDim, h - kActionDim) = hist.head(h - kActionDim);
+    input_.segment(d, kActionDim) = a.cast<float>();
+  }
+  return a;
+}
+
+std::string MlpPolicy::name() const { return weights_->history > 0 ? "mlp-delay-aware" : "mlp"; }
+
+std::unique_ptr<Policy> MlpPolicy::clone() const { return std::make_unique<MlpPolicy>(weights_, sha256_); }
+
+}  // namespace actionshift::policy

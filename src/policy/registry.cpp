@@ -1,0 +1,49 @@
+// backbone names -> policies
+#include "actionshift/policy/registry.hpp"
+
+#include "actionshift/core/error.hpp"
+#include "actionshift/policy/delay_aware.hpp"
+#include "actionshift/policy/expert.hpp"
+#include "actionshift/policy/mlp.hpp"
+
+#include <cstdlib>
+
+namespace actionshift::policy {
+
+std::string default_backbones_dir() {
+  if (const char* env = std::getenv("ACTIONSHIFT_BACKBONES_DIR"); env != nullptr && *env != '\0') return env;
+  return ACTIONSHIFT_DEFAULT_BACKBONES_DIR;
+}
+
+std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const std::string& backbones_dir) {
+  const std::string dir = backbones_dir.empty() ? default_backbones_dir() : backbones_dir;
+  return dir + "/" + std::string(sim::task_name(task)) + "." + std::string(backbone) + ".asmlp";
+}
+
+std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware"}; }
+
+std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task, const RegistryOptions& options) {
+  if (backbone == "expert") return make_expert(task);
+  if (backbone == "expert-delay-aware") return std::make_unique<DelayAwareExpert>(task);
+  if (backbone == "mlp" || backbone == "mlp-delay-aware" || backbone.starts_with("mlp:")) {
+    const std::string path = backbone.starts_with("mlp:") ? std::string(backbone.substr(4))
+                                                          : mlp_weights_path(backbone, task, options.backbones_dir);
+    auto p = MlpPolicy::from_file(path);
+    if (p->task() != task)
+      throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
+                                         std::string(sim::task_name(task)));
+    if (backbone == "mlp-delay-aware" && p->weights().history == 0)
+      throw InputError(path, "history", "mlp-delay-aware needs a network with an action history");
+    return p;
+  }
+  if (backbone.starts_with("external:")) {
+    const std::string cmd(backbone.substr(9));
+    if (cmd.empty()) throw InputError("", "backbone", "external: needs a command, e.g. external:python3 policy.py");
+    return std::make_unique<ExternalPolicy>(cmd, task, options.external);
+  }
+  throw InputError("", "backbone",
+                   "unknown backbone '" + std::string(backbone) +
+                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<path>, external:<command>)");
+}
+
+}  // namespace actionshift::policy

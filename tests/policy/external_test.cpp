@@ -1,0 +1,80 @@
+// external-process policy: the Python example completes episodes; dead, silent and garbage
+// processes give clear errors instead of hangs or crashes
+#include "actionshift/core/hash.hpp"
+#include "actionshift/policy/external.hpp"
+#include "actionshift/policy/gate0.hpp"
+#include "actionshift/policy/registry.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+using namespace actionshift;
+using ::testing::HasSubstr;
+
+namespace {
+
+const std::string kReady = R"(read l; echo '{"type":"ready"}'; )";
+
+template <class F>
+void expect_runtime_error(F f, const std::string& part) {
+  EXPECT_THAT(f, ::testing::ThrowsMessage<std::runtime_error>(HasSubstr(part)));
+}
+
+Eigen::VectorXd pick_obs() { return Eigen::VectorXd::Zero(sim::observation_layout(sim::TaskId::kPickCube).size()); }
+
+#ifdef ACTIONSHIFT_PYTHON
+TEST(ExternalPolicy, PythonExampleSolvesPickCube) {
+  const std::string cmd = std::string(ACTIONSHIFT_PYTHON) + " " ACTIONSHIFT_SOURCE_DIR "/docs/examples/external_policy.py";
+  auto p = policy::make_policy("external:" + cmd, sim::TaskId::kPickCube);
+  EXPECT_EQ(p->name(), "external:" + cmd);
+  policy::Gate0Run run;
+  run.episodes = 6;
+  run.threads = 2;
+  const auto v = policy::run_gate0(*p, run);
+  EXPECT_GE(v.competence.interval.successes, 5);
+  EXPECT_EQ(v.decision, "advance");
+}
+#endif
+
+TEST(ExternalPolicy, ProcessThatDiesIsAnError) {
+  expect_runtime_error([] { policy::ExternalPolicy("exit 3", sim::TaskId::kPickCube); }, "process exited with status 3");
+  policy::ExternalPolicy p(kReady + "read l; read l; exit 4", sim::TaskId::kPickCube);
+  p.reset();
+  expect_runtime_error([&] { p.act(pick_obs()); }, "step 0: process exited with status 4 before replying");
+}
+
+TEST(ExternalPolicy, GarbageRepliesAreErrors) {
+  policy::ExternalPolicy p(kReady + "read l; read l; echo 'hello there'; read l; echo '{\"action\":[1,2]}'; sleep 5",
+                           sim::TaskId::kPickCube);
+  p.reset();
+  expect_runtime_error([&] { p.act(pick_obs()); }, "step 0: bad reply (not JSON): 'hello there'");
+  expect_runtime_error([&] { p.act(pick_obs()); }, "action must be an array of 7 numbers");
+  expect_runtime_error([] { policy::ExternalPolicy("read l; echo '{}'; sleep 5", sim::TaskId::kPickCube); },
+                       "hello: expected {\"type\":\"ready\"}");
+}
+
+TEST(ExternalPolicy, SilentProcessTimesOut) {
+  policy::ExternalOptions o;
+  o.step_timeout_s = 0.3;
+  policy::ExternalPolicy p(kReady + "sleep 30", sim::TaskId::kPickCube, o);
+  p.reset();
+  expect_runtime_error([&] { p.act(pick_obs()); }, "no reply within 0.300 s (timeout)");
+}
+
+TEST(ExternalPolicy, WellBehavedProcessRoundTrip) {
+  // a shell policy that always answers the same action
+  const std::string cmd = kReady + R"(while read l; do case "$l" in *'"step"'*) echo '{"action":[0.5,0,0,0,0,0,-1]}';; esac; done)";
+  policy::ExternalPolicy p(cmd, sim::TaskId::kPickCube);
+  p.reset();
+  for (int t = 0; t < 3; ++t) {
+    const Action a = p.act(pick_obs());
+    EXPECT_DOUBLE_EQ(a(0), 0.5);
+    EXPECT_DOUBLE_EQ(a(6), -1.0);
+  }
+  EXPECT_EQ(p.sha256(), sha256_hex(cmd));
+  auto c = p.clone();
+  c->reset();
+  EXPECT_DOUBLE_EQ(c->act(pick_obs())(0), 0.5);
+}
+
+}  // namespace

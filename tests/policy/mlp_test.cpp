@@ -1,0 +1,103 @@
+// MLP weight format: round trip, clear errors for truncated / corrupt / wrong-shape files, history
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/policy/mlp.hpp"
+#include "actionshift/policy/registry.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace actionshift;
+using ::testing::HasSubstr;
+
+namespace {
+
+policy::MlpWeights small_net(sim::TaskId task, int history = 0) {
+  auto w = policy::MlpWeights::init(task, history, {16, 8}, 11);
+  w.input_mean.setConstant(0.1f);
+  w.input_std.setConstant(2.0f);
+  return w;
+}
+
+template <class F>
+void expect_input_error(F f, const std::string& part) {
+  EXPECT_THAT(f, ::testing::ThrowsMessage<InputError>(HasSubstr(part)));
+}
+
+TEST(MlpFormat, RoundTripKeepsTheFunction) {
+  const auto w = small_net(sim::TaskId::kPushCube);
+  const std::string bytes = policy::serialize_mlp(w);
+  const auto back = policy::parse_mlp(bytes, "net.asmlp");
+  EXPECT_EQ(back.layers, w.layers);
+  const Eigen::VectorXf x = Eigen::VectorXf::LinSpaced(35, -1.0f, 1.0f);
+  EXPECT_TRUE(policy::mlp_forward(w, x).isApprox(policy::mlp_forward(back, x)));
+  EXPECT_EQ(policy::serialize_mlp(back), bytes);
+}
+
+TEST(MlpFormat, TruncatedCorruptAndWrongShapeAreOneLineErrors) {
+  const std::string bytes = policy::serialize_mlp(small_net(sim::TaskId::kPickCube));
+  expect_input_error([&] { policy::parse_mlp(bytes.substr(0, bytes.size() - 5), "w.asmlp"); }, "w.asmlp: payload: truncated");
+  expect_input_error([&] { policy::parse_mlp(bytes.substr(0, 10), "w.asmlp"); }, "truncated");
+  expect_input_error([&] { policy::parse_mlp(bytes + "xx", "w.asmlp"); }, "trailing bytes");
+  std::string corrupt = bytes;
+  corrupt[corrupt.size() - 3] ^= 0x5a;
+  expect_input_error([&] { policy::parse_mlp(corrupt, "w.asmlp"); }, "checksum mismatch");
+  std::string magic = bytes;
+  magic[0] = 'X';
+  expect_input_error([&] { policy::parse_mlp(magic, "w.asmlp"); }, "bad magic");
+  // a pick_cube network relabelled as push_cube: the input size no longer matches the task
+  std::string relabel = bytes;
+  const auto at = relabel.find("\"task\":\"pick_cube\"");
+  ASSERT_NE(at, std::string::npos);
+  relabel.replace(at, 18, "\"task\":\"push_cube\"");
+  expect_input_error([&] { policy::parse_mlp(relabel, "w.asmlp"); }, "input size 42 does not match task push_cube (expected 35)");
+  expect_input_error([] { policy::load_mlp("/nonexistent/w.asmlp"); }, "/nonexistent/w.asmlp: cannot open weight file");
+}
+
+TEST(MlpPolicy, HistoryHoldsTheLastFourActionsMostRecentFirst) {
+  // a network whose output is independent of the history, so the history is just its own outputs
+  auto w = std::make_shared<policy::MlpWeights>(small_net(sim::TaskId::kPushCube, policy::kHistoryLength));
+  EXPECT_EQ(w->input_dim(), 35 + 28);
+  policy::MlpPolicy p(w, "0");
+  p.reset();
+  Eigen::VectorXd obs = Eigen::VectorXd::Zero(35);
+  std::vector<Action> out;
+  for (int t = 0; t < 6; ++t) {
+    obs(0) = 0.1 * t;
+    out.push_back(p.act(obs));
+  }
+  // replaying with a plain forward pass and a hand-built history reproduces every output
+  for (int t = 0; t < 6; ++t) {
+    Eigen::VectorXf x = Eigen::VectorXf::Zero(63);
+    x(0) = static_cast<float>(0.1 * t);
+    for (int j = 0; j < 4 && t - 1 - j >= 0; ++j) x.segment(35 + 7 * j, 7) = out[static_cast<std::size_t>(t - 1 - j)].cast<float>();
+    EXPECT_TRUE(policy::mlp_forward(*w, x).isApprox(out[static_cast<std::size_t>(t)], 1e-6)) << t;
+  }
+  p.reset();
+  obs(0) = 0.0;
+  EXPECT_TRUE(p.act(obs).isApprox(out[0]));
+  EXPECT_EQ(p.name(), "mlp-delay-aware");
+}
+
+TEST(MlpBackbones, CommittedWeightsLoadWithAbout80kParameters) {
+  for (sim::TaskId task : {sim::TaskId::kPickCube, sim::TaskId::kPushCube, sim::TaskId::kPullCube, sim::TaskId::kStackCube}) {
+    const std::string path = policy::mlp_weights_path("mlp", task, ACTIONSHIFT_SOURCE_DIR "/configs/backbones");
+    auto p = policy::MlpPolicy::from_file(path);
+    EXPECT_EQ(p->task(), task);
+    EXPECT_NEAR(static_cast<double>(p->weights().parameter_count()), 80000.0, 4000.0) << path;
+    EXPECT_LT(std::filesystem::file_size(path), 2u * 1024 * 1024);
+    std::ifstream f(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(p->sha256(), sha256_hex(bytes));
+  }
+  expect_input_error(
+      [] {
+        policy::make_policy("mlp:" ACTIONSHIFT_SOURCE_DIR "/configs/backbones/pick_cube.mlp.asmlp", sim::TaskId::kPushCube);
+      },
+      "weights are for pick_cube, not push_cube");
+}
+
+}  // namespace
