@@ -405,7 +405,7 @@ void PhysicsWorld::step_control() {
         motors_[static_cast<std::size_t>(i)]->setMaxAppliedImpulse(f * h_);
       }
       // exact gravity compensation: cancels the m*g the world applies to every link
-      robot_->addLinkForce(i, -g * robot_->getLinkMass(i));
+      if (cfg_.gravity_compensation) robot_->addLinkForce(i, -g * robot_->getLinkMass(i));
     }
     world_->stepSimulation(h_, 0, h_);
   }
@@ -467,8 +467,14 @@ Eigen::Vector3d PhysicsWorld::finger_contact_force(int finger_slot, int object) 
   return finger_forces_[static_cast<std::size_t>(finger_slot) * objects_.size() + static_cast<std::size_t>(object)];
 }
 Eigen::Isometry3d PhysicsWorld::body_urdf_pose(int body) const {
-  const btTransform t = robot_->getLink(body).m_cachedWorldTransform;
-  return eig(t) * layout_.bodies[static_cast<std::size_t>(body)].link_to_bullet.inverse();
+  // bullet's own kinematics of the current state (not the eigen chain): link frame -> world
+  const btVector3 origin = robot_->localPosToWorld(body, btVector3(0, 0, 0));
+  const btMatrix3x3 basis = robot_->localFrameToWorld(body, btMatrix3x3::getIdentity());
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) t.linear()(r, c) = basis[r][c];
+  t.translation() = eig(origin);
+  return t * layout_.bodies[static_cast<std::size_t>(body)].link_to_bullet.inverse();
 }
 
 }  // namespace actionshift::sim::detail

@@ -13,7 +13,8 @@ struct PhysicsConfig {
   int sim_steps_per_control{5};       ///< 100 Hz simulation steps per control step
   int substeps_per_sim_step{1};       ///< Bullet steps per simulation step (1: 10 ms physics; 2: 5 ms, see docs/sim.md)
   int solver_iterations{15};          ///< sequential-impulse iterations per Bullet step
-  double gravity{9.81};               ///< [m/s^2], objects only; the robot is gravity compensated exactly
+  double gravity{9.81};               ///< [m/s^2]
+  bool gravity_compensation{true};    ///< cancel gravity on every robot link exactly (ManiSkill disables it)
   double drive_stiffness{1000.0};     ///< K of ManiSkill's joint PD drive [N m/rad] or [N/m]
   double drive_damping{100.0};        ///< D of ManiSkill's joint PD drive [N m s/rad] or [N s/m]
   double arm_force_limit{100.0};      ///< [N m] per arm joint (ManiSkill's drive force limit)
