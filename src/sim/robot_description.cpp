@@ -1,6 +1,8 @@
 // urdf parsing (urdfdom) and mesh loading (assimp) into the plain RobotDescription value type
 #include "actionshift/sim/robot_description.hpp"
 
+#include "actionshift/core/error.hpp"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -31,7 +33,7 @@ Eigen::Isometry3d to_iso(const urdf::Pose& p) {
 }
 
 [[noreturn]] void fail(std::string_view origin, const std::string& what) {
-  throw std::runtime_error(std::string(origin) + ": " + what);
+  throw InputError(std::string(origin), "", what);
 }
 
 // process-wide cache of unscaled meshes keyed by resolved path

@@ -1,6 +1,8 @@
 // urdf loading: the embedded panda, meshes through assimp, path resolution, clear errors
 #include "actionshift/sim/robot_description.hpp"
 
+#include "actionshift/core/error.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -97,7 +99,7 @@ TEST_F(UrdfFiles, MissingMeshIsAClearError) {
   try {
     load_urdf_file(dir_ / "bad.urdf");
     FAIL() << "expected an error";
-  } catch (const std::runtime_error& e) {
+  } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("bad.urdf"));
     EXPECT_THAT(e.what(), HasSubstr("missing.obj"));
   }
@@ -106,13 +108,13 @@ TEST_F(UrdfFiles, MissingMeshIsAClearError) {
 TEST_F(UrdfFiles, UnreadableMeshAndUnknownPackageAndBadXml) {
   write(dir_ / "meshes" / "junk.obj", "this is not a mesh\n");
   write(dir_ / "junk.urdf", urdf("meshes/junk.obj", "meshes/box.obj"));
-  EXPECT_THAT([&] { load_urdf_file(dir_ / "junk.urdf"); }, ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("junk.obj")));
+  EXPECT_THAT([&] { load_urdf_file(dir_ / "junk.urdf"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("junk.obj")));
   write(dir_ / "pkg.urdf", urdf("package://nowhere/box.obj", "meshes/box.obj"));
-  EXPECT_THAT([&] { load_urdf_file(dir_ / "pkg.urdf"); }, ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("nowhere")));
+  EXPECT_THAT([&] { load_urdf_file(dir_ / "pkg.urdf"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("nowhere")));
   write(dir_ / "xml.urdf", "<robot name='x'><link name='a'>");
-  EXPECT_THAT([&] { load_urdf_file(dir_ / "xml.urdf"); }, ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("xml.urdf")));
+  EXPECT_THAT([&] { load_urdf_file(dir_ / "xml.urdf"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("xml.urdf")));
   EXPECT_THAT([&] { load_urdf_file(dir_ / "does_not_exist.urdf"); },
-              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("does_not_exist.urdf")));
+              ::testing::ThrowsMessage<InputError>(HasSubstr("does_not_exist.urdf")));
 }
 
 }  // namespace

@@ -82,8 +82,8 @@ using PackageMap = std::map<std::string, std::filesystem::path>;
 /// Parse a URDF file. Relative mesh paths resolve against the file's directory,
 /// `package://` through `packages`, `file://` as absolute paths. Meshes are loaded (and
 /// cached per process) through assimp.
-/// throws actionshift::InputError-compatible std::runtime_error naming the file on any failure
-/// (unreadable URDF, bad XML, missing or unreadable mesh).
+/// throws actionshift::InputError (what() = "<urdf file>: <reason naming the mesh>") on any failure:
+/// unreadable URDF, bad XML, unsupported joint type, unknown package, missing or unreadable mesh.
 RobotDescription load_urdf_file(const std::filesystem::path& urdf, const PackageMap& packages = {});
 
 /// Parse URDF text; `base_dir` resolves relative mesh paths, `origin_name` names the source in errors.
