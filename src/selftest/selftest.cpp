@@ -88,17 +88,43 @@ bool validate(const Options& o, std::string* err) noexcept {
 
 struct SelfTest::Impl {
   Impl(const Options& o, std::vector<Contract> declared)
-      : opt(o),
-        pool(std::move(declared)),
-        adapter(pool, o.model, o.strategy == Strategy::kFixed ? adapt::ProbeStrategy::kFixed : adapt::ProbeStrategy::kEntropy,
-                probe_options(o)) {}
-
-  static adapt::ProbeOptions probe_options(const Options& o) {
-    adapt::ProbeOptions p;
-    p.budget = o.budget;
-    p.amplitude = o.amplitude;
-    return p;
+      : opt(o), pool(std::move(declared)), belief(pool, o.model), candidates(adapt::probe_candidates(o.amplitude)) {
+    preview.budget = o.budget;
+    preview.amplitude = o.amplitude;  // calibrated, lag-aware preview (adapt::ProbeOptions defaults)
   }
+
+  // the next probe: fixed pulses, or the entropy-minimising axis pulse among the admissible ones:
+  // - return balancing: a channel whose commanded raw sum is non-zero may only be pulsed back to zero;
+  // - no saturation: no hypothesis holding posterior mass may decode the pulse beyond the controller's
+  //   clip range (|translation_i| <= 1, |rotation| <= 1, DESIGN §3), which the response model does not
+  //   describe (an absolute-target wiring turns +a then −a on one channel into a 2·scale·a step).
+  // if nothing is admissible the balance rule alone decides
+  Action choose(const Mat3& R) const {
+    const int step = static_cast<int>(raws.size());
+    if (opt.strategy == Strategy::kFixed) return adapt::fixed_probe_pulse(step, opt.amplitude);
+    const std::vector<double> eh = adapt::expected_posterior_entropy(belief, candidates, R, preview);
+    const Eigen::VectorXd p = belief.probs();
+    std::vector<Action> preds;
+    std::size_t best = candidates.size(), fallback = candidates.size();
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      if (opt.return_balanced) {
+        const int ch = static_cast<int>(i % kPoseDim);
+        if (std::abs(raw_sum[ch] + candidates[i][ch]) > opt.amplitude * (1.0 + 1e-12)) continue;
+      }
+      if (fallback == candidates.size() || eh[i] < eh[fallback]) fallback = i;
+      belief.preview(candidates[i], R, /*lag_aware=*/true, preds);
+      bool saturates = false;
+      for (int h = 0; h < belief.size() && !saturates; ++h) {
+        if (p[h] < kPlausible) continue;
+        const Action& c = preds[static_cast<std::size_t>(h)];
+        saturates = c.head<3>().cwiseAbs().maxCoeff() > 1.0 + 1e-9 || c.segment<3>(3).norm() > 1.0 + 1e-9;
+      }
+      if (saturates) continue;
+      if (best == candidates.size() || eh[i] < eh[best]) best = i;
+    }
+    return candidates[best < candidates.size() ? best : fallback];
+  }
+  static constexpr double kPlausible = 1e-4;  // posterior mass below which a hypothesis may saturate
 
   Mat3 rotation_of(const TcpPose& p) const {
     if (opt.frame_rotation == FrameRotation::kIdentity) return Mat3::Identity();
@@ -107,7 +133,10 @@ struct SelfTest::Impl {
 
   Options opt;
   std::vector<Contract> pool;
-  adapt::ProbingAdapter adapter;
+  adapt::PoolBelief belief;
+  std::vector<Action> candidates;  // +a·e0 … +a·e5, −a·e0 … −a·e5
+  adapt::ProbeOptions preview;
+  Pose6 raw_sum{Pose6::Zero()};    // commanded raw pose sum since begin()
 
   bool started{false};
   TcpPose start, last;
@@ -147,7 +176,8 @@ SelfTest::~SelfTest() = default;
 bool SelfTest::try_begin(const TcpPose& p, std::string* err) noexcept {
   if (!check_pose(p, "begin", err)) return false;
   auto& s = *impl_;
-  s.adapter.begin_episode(s.opt.seed);
+  s.belief.reset();
+  s.raw_sum.setZero();
   s.started = true;
   s.start = s.last = p;
   s.pending.reset();
@@ -171,7 +201,7 @@ std::optional<Action> SelfTest::next_probe() {
   if (s.pending) return s.pending;
   if (static_cast<int>(s.raws.size()) >= s.opt.budget) return std::nullopt;
   s.pending_R = s.rotation_of(s.last);
-  Action raw = s.adapter.encode(Action::Zero(), s.pending_R);  // zero intent: every budget step probes
+  Action raw = s.choose(s.pending_R);
   // the probe bound is a promise to the caller's hardware: enforce it, whatever the strategy did
   for (int c = 0; c < kPoseDim; ++c) raw[c] = std::clamp(raw[c], -s.opt.amplitude, s.opt.amplitude);
   raw[kGripper] = 0.0;
@@ -194,7 +224,8 @@ bool SelfTest::try_observe(const TcpPose& p, std::string* err) noexcept {
   conj.tail<3>() *= -1.0;
   response.tail<3>() = adapt::quat_to_rotvec(adapt::quat_multiply(p.quaternion, conj));
 
-  s.adapter.observe(*s.pending, response, s.pending_R);
+  s.belief.update(*s.pending, response, s.pending_R);
+  s.raw_sum += s.pending->head<kPoseDim>();
   s.raws.push_back(*s.pending);
   s.rotations.push_back(s.pending_R);
   s.responses.push_back(response);
@@ -221,11 +252,11 @@ bool SelfTest::done() const noexcept {
 int SelfTest::probes_observed() const noexcept { return static_cast<int>(impl_->raws.size()); }
 const Options& SelfTest::options() const noexcept { return impl_->opt; }
 const std::vector<Contract>& SelfTest::pool() const noexcept { return impl_->pool; }
-Eigen::VectorXd SelfTest::posterior() const { return impl_->adapter.belief().probs(); }
+Eigen::VectorXd SelfTest::posterior() const { return impl_->belief.probs(); }
 
 Evidence SelfTest::evidence() const {
   const auto& s = *impl_;
-  const auto& belief = s.adapter.belief();
+  const auto& belief = s.belief;
   const Eigen::VectorXd p = belief.probs();
   const int map = belief.map_index();
   Evidence e;

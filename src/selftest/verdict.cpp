@@ -141,7 +141,9 @@ std::string Verdict::safety_statement(const std::string& unit) const {
                   fmt("%.4f", displacement) + " " + unit + " path over " + std::to_string(probe_steps) +
                   " probe steps (largest distance from the start " + fmt("%.4f", max_excursion) + " " + unit +
                   ", rotation " + fmt("%.4f", rotation) + " rad).";
-  if (finger_travel >= 0) s += " Finger travel while probing: " + fmt("%.4f", finger_travel) + " " + unit + ".";
+  if (finger_travel >= 0)
+    s += " Finger travel while probing: " + fmt("%.4f", finger_travel) + " " + unit +
+         " (the gripper channel is held at 0, which a controller may map to a mid finger target).";
   return s;
 }
 

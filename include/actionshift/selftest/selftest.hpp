@@ -35,7 +35,8 @@ namespace actionshift::selftest {
 
 enum class Strategy {
   kFixed,    ///< +amplitude on channels 0..5 in turn, then −amplitude, ... (reference `fixed_probe_pulse`)
-  kEntropy,  ///< greedy one-step minimum expected posterior entropy over the 12 axis pulses
+  kEntropy,  ///< greedy one-step minimum expected posterior entropy over the 12 axis pulses (reference §5.2,
+             ///< calibrated and lag-aware preview), return-balanced unless Options::return_balanced is false
 };
 const char* to_string(Strategy s);  ///< "fixed" or "entropy"
 
@@ -66,7 +67,12 @@ struct Options {
   double misspec_ratio{4.0};        ///< abstain if the MAP's fit ratio exceeds this, > 0
   FrameRotation frame_rotation{FrameRotation::kMeasured};  ///< rotation for tool-frame decoding
   double min_frame_angle{0.2};      ///< [rad] frame is checked only if the TCP orientation stays at least this far from identity
-  std::uint64_t seed{20260720};     ///< seeds the probe adapter (unused by fixed and entropy)
+  /// Entropy strategy: a channel whose commanded raw sum is non-zero may only be pulsed back towards
+  /// zero, so the summed raw command of every channel stays within ±amplitude. Under any delta wiring
+  /// the TCP then stays within one pulse's response of its start, whatever the wiring (the reference's
+  /// greedy choice can pulse the same direction every step and walk the arm to its reach limit, where
+  /// the response saturates and mimics a scale change). The fixed pulses are balanced by construction.
+  bool return_balanced{true};
 };
 
 /// Checks `o`; on failure returns false and sets `*err` (if non-null) to one line naming the field,
