@@ -2,6 +2,7 @@
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
 #include "cmd_policy.hpp"
+#include "cmd_selftest.hpp"
 #include "commands.hpp"
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,7 @@
 #include <exception>
 #include <functional>
 #include <iostream>
+#include <string_view>
 
 using namespace actionshift;
 
@@ -117,11 +119,44 @@ int main(int argc, char** argv) {
   gate0->add_flag("--progress,!--quiet", gate0_o.progress, "No progress on stderr");
   gate0->callback([&] { action = [&] { return cli::run_gate0(gate0_o); }; });
 
+  // ---- selftest (plug-and-verify; its own exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input)
+  cli::SelftestOptions st_o;
+  auto* st = app.add_subcommand(
+      "selftest",
+      "Plug-and-verify self-test: probe with bounded pulses, identify the action wiring over a declared pool\n"
+      "and answer PASS, MISMATCH (with the diff in words) or INCONCLUSIVE (abstain). Contract arguments: a\n"
+      "library name, MANIFEST:INDEX (e.g. reference_seen:0), a file with contract JSON, or inline JSON.\n"
+      "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
+  st->add_option("--task", st_o.task, "Task (with --sim: pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side)")
+      ->capture_default_str();
+  auto* st_demo = st->add_option("--demo", st_o.demo,
+                                 "Synthetic demo wiring: identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled");
+  st->add_option("--hidden-contract", st_o.hidden_contract, "The robot's true wiring (default: the expected contract)")
+      ->excludes(st_demo);
+  st->add_option("--expected", st_o.expected, "The wiring the policy assumes")->capture_default_str();
+  st->add_flag("--sim", st_o.sim, "Probe the Bullet environment of --task instead of the synthetic stand-in");
+  st->add_option("--calibration", st_o.calibration, "--sim: response calibration JSON (default: the task's built-in one)");
+  st->add_option("--frame-rotation", st_o.frame_rotation, "--sim: live (TCP orientation) or identity")->capture_default_str();
+  st->add_option("--pool", st_o.pools,
+                 "Declared pool: library, a manifest name or file (repeatable; default library, with --sim library + reference9)");
+  st->add_option("--strategy", st_o.strategy, "Probe strategy: fixed or entropy")->capture_default_str();
+  st->add_option("--budget", st_o.budget, "Probe steps (default 6, also with --sim: docs/selftest.md)");
+  st->add_option("--amplitude", st_o.amplitude, "Probe bound per pose channel, in (0, 1] (default 0.5)");
+  st->add_option("--confidence-floor", st_o.confidence_floor, "Per-field confidence needed to resolve a field")
+      ->capture_default_str();
+  st->add_option("--misspec-ratio", st_o.misspec_ratio, "Abstain when the best fit exceeds this many times the noise")
+      ->capture_default_str();
+  st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
+  st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
+  st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::cerr << "actionshift: error: " << e.what() << " (see --help)\n";
+    // selftest's bad-input exit code is 3 (2 means INCONCLUSIVE there)
+    if (argc > 1 && std::string_view(argv[1]) == "selftest") return cli::kSelftestBadInput;
     return cli::kBadInput;
   }
   try {

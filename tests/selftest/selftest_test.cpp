@@ -184,6 +184,57 @@ TEST(SelfTest, ProbesAreBoundedAndNeverActuateTheGripper) {
   }
 }
 
+TEST(SelfTest, EntropyProbesReturnTowardsTheStart) {
+  // every channel's summed raw command stays within ±amplitude, so a delta-wired TCP cannot drift
+  Options o = synthetic_options(Strategy::kEntropy);
+  o.budget = 40;
+  SelfTest st(o);
+  SyntheticRobot robot(Contract::identity(), o.model, 5);
+  st.begin(robot.pose());
+  Pose6 sum = Pose6::Zero();
+  while (auto raw = st.next_probe()) {
+    sum += raw->head<6>();
+    EXPECT_LE(sum.cwiseAbs().maxCoeff(), 0.5 + 1e-12);
+    robot.send(*raw);
+    st.observe(robot.pose());
+  }
+  EXPECT_EQ(st.verdict().status, Status::kPass);
+  EXPECT_LE(st.verdict().max_excursion, 0.5 * std::sqrt(3.0) + 0.5);  // one pulse per axis plus noise
+  o.return_balanced = false;  // the reference's greedy choice: repeats the most informative pulse
+  SelfTest greedy(o);
+  SyntheticRobot robot2(Contract::identity(), o.model, 5);
+  greedy.begin(robot2.pose());
+  Pose6 sum2 = Pose6::Zero();
+  while (auto raw = greedy.next_probe()) {
+    sum2 += raw->head<6>();
+    robot2.send(*raw);
+    greedy.observe(robot2.pose());
+  }
+  EXPECT_GT(sum2.cwiseAbs().maxCoeff(), 0.5);
+}
+
+TEST(SelfTest, NoProbeSaturatesTheControllerUnderAPlausibleWiring) {
+  // absolute target, scale 2 on channel 0: +0.5 then −0.5 on raw channel 0 would decode to a −2 step
+  ContractFields f;
+  f.target = "absolute";
+  f.scale = {2.0, 1.0, 1.0, 1.0, 1.0, 1.0};
+  const Contract hidden = Contract::make(f);
+  Options o = synthetic_options(Strategy::kEntropy);
+  o.pool = default_pool(o.expected);
+  o.pool.push_back(hidden);
+  o.budget = 20;
+  SelfTest st(o);
+  SyntheticRobot robot(hidden, o.model, 9);
+  st.begin(robot.pose());
+  while (auto raw = st.next_probe()) {
+    robot.send(*raw);
+    EXPECT_LE(robot.last_canonical().head<3>().cwiseAbs().maxCoeff(), 1.0 + 1e-9);
+    EXPECT_LE(robot.last_canonical().segment<3>(3).norm(), 1.0 + 1e-9);
+    st.observe(robot.pose());
+  }
+  EXPECT_EQ(st.verdict().evidence.identified, hidden);
+}
+
 TEST(SelfTest, FixedStrategySendsTheReferencePulses) {
   Options o = synthetic_options(Strategy::kFixed);
   o.budget = 8;

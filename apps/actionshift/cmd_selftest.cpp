@@ -1,0 +1,203 @@
+// `actionshift selftest`: resolves the arguments, builds a SelfTest, drives it against the synthetic
+// stand-in or the Bullet environment (the library itself never links the simulator), prints the report.
+#include "cmd_selftest.hpp"
+
+#include "actionshift/adapt/calibration.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/data/builtin_manifests.hpp"
+#include "actionshift/selftest/library.hpp"
+#include "actionshift/selftest/selftest.hpp"
+#include "actionshift/selftest/synthetic_robot.hpp"
+#include "actionshift/sim/hidden_contract_env.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace actionshift::cli {
+
+namespace {
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (!in && !in.eof()) throw InputError(path, "", "cannot read file");
+  return s.str();
+}
+
+// a contract argument: library name, MANIFEST:INDEX, file with contract JSON, or inline JSON
+Contract resolve_contract(const std::string& arg, const std::string& option) {
+  if (auto c = selftest::named_contract(arg)) return *c;
+  if (const auto colon = arg.rfind(':'); colon != std::string::npos && colon + 1 < arg.size() &&
+                                         arg.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
+                                         arg.find('{') == std::string::npos) {
+    const Manifest m = data::resolve_manifest(arg.substr(0, colon));
+    const auto cs = m.contracts();
+    const std::size_t i = std::stoul(arg.substr(colon + 1));
+    if (i >= cs.size())
+      throw InputError("", option, "'" + arg + "': index out of range (the manifest has " + std::to_string(cs.size()) +
+                                       " contracts)");
+    return cs[i];
+  }
+  std::error_code ec;
+  const bool is_file = arg.find('{') == std::string::npos && std::filesystem::is_regular_file(arg, ec);
+  const std::string text = is_file ? read_text(arg) : arg;
+  if (!is_file && arg.find('{') == std::string::npos)
+    throw InputError("", option,
+                     "'" + arg + "' is not a library name (" + selftest::named_contract_list() +
+                         "), MANIFEST:INDEX, a contract file or contract JSON");
+  try {
+    return Contract::from_json(text);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(is_file ? arg : "", option, e.what());
+  }
+}
+
+std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
+  std::vector<Contract> pool;
+  for (const auto& n : names) {
+    if (n == "library") {
+      for (const auto& c : selftest::library()) pool.push_back(c.contract);
+    } else {
+      for (const auto& c : data::resolve_manifest(n).contracts()) pool.push_back(c);
+    }
+  }
+  std::vector<Contract> unique;  // keep the first occurrence (MAP ties go to the lowest index)
+  for (auto& c : pool)
+    if (std::find(unique.begin(), unique.end(), c) == unique.end()) unique.push_back(std::move(c));
+  return unique;
+}
+
+adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
+  if (!o.calibration.empty()) return adapt::ResponseCalibration::load(o.calibration);
+  if (auto text = data::builtin_calibration_text(o.task))
+    return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.task);
+  throw InputError("", "--calibration",
+                   "no built-in response calibration for task '" + o.task + "' in this build: pass --calibration FILE");
+}
+
+selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::ObservationLayout& layout) {
+  const sim::ObsField& tcp = layout.at("tcp_pose");
+  selftest::TcpPose p;
+  p.position = obs.segment<3>(tcp.offset);
+  p.quaternion = obs.segment<4>(tcp.offset + 3);
+  if (const sim::ObsField* q = layout.find("qpos"); q && q->width == 9) p.fingers = obs.segment<2>(q->offset + 7);
+  return p;
+}
+
+// drives the self-test against the Bullet environment under the hidden contract; returns a note if
+// the episode ended early
+std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o) {
+  const sim::TaskId task = sim::parse_task(o.task);
+  auto model = sim::EnvModel::make(task);
+  sim::HiddenContractEnv env(model, hidden,
+                             o.frame_rotation == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp);
+  st.begin(pose_from_obs(env.reset(o.seed), env.layout()));
+  while (auto raw = st.next_probe()) {
+    const sim::StepResult& r = env.step(*raw);
+    if (r.safety != sim::SafetyFlag::kNone)
+      return "the environment ended the episode with safety flag " + std::string(sim::safety_flag_name(r.safety)) +
+             " after " + std::to_string(st.probes_observed()) + " probes";
+    st.observe(pose_from_obs(r.obs, env.layout()));
+    if (r.episode_over() && !st.done())
+      return "the episode reached the task horizon after " + std::to_string(st.probes_observed()) + " probes";
+  }
+  return {};
+}
+
+int run(const SelftestOptions& o) {
+  if (!o.demo.empty() && !o.hidden_contract.empty())
+    throw InputError("", "--demo", "--demo and --hidden-contract are mutually exclusive");
+  if (o.sim && !o.demo.empty()) throw InputError("", "--demo", "--demo is synthetic; use --hidden-contract with --sim");
+  if (o.strategy != "fixed" && o.strategy != "entropy")
+    throw InputError("", "--strategy", "must be fixed or entropy (got '" + o.strategy + "')");
+  if (o.frame_rotation != "live" && o.frame_rotation != "identity")
+    throw InputError("", "--frame-rotation", "must be live or identity (got '" + o.frame_rotation + "')");
+  if (!o.sim && o.frame_rotation != "live") throw InputError("", "--frame-rotation", "only applies with --sim");
+  if (!o.sim && !o.calibration.empty()) throw InputError("", "--calibration", "only applies with --sim");
+
+  selftest::Options so;
+  so.expected = resolve_contract(o.expected, "--expected");
+  Contract hidden = so.expected;
+  if (!o.demo.empty()) {
+    bool found = false;
+    for (const auto& d : selftest::demos())
+      if (d.name == o.demo) {
+        hidden = d.contract;
+        found = true;
+      }
+    if (!found)
+      throw InputError("", "--demo",
+                       "unknown demo '" + o.demo +
+                           "' (identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled)");
+  } else if (!o.hidden_contract.empty()) {
+    hidden = resolve_contract(o.hidden_contract, "--hidden-contract");
+  }
+  std::vector<std::string> pool_names = o.pools;
+  if (pool_names.empty()) pool_names = o.sim ? std::vector<std::string>{"library", "reference9"} : std::vector<std::string>{"library"};
+  so.pool = selftest::with_expected(resolve_pool(pool_names), so.expected);
+  so.strategy = o.strategy == "fixed" ? selftest::Strategy::kFixed : selftest::Strategy::kEntropy;
+  so.budget = o.budget.value_or(o.sim ? kSimDefaultBudget : 6);
+  so.amplitude = o.amplitude.value_or(o.sim ? kSimDefaultAmplitude : 0.5);
+  so.confidence_floor = o.confidence_floor;
+  so.misspec_ratio = o.misspec_ratio;
+
+  selftest::ReportHeader h;
+  h.task = o.task;
+  h.strategy = o.strategy;
+  std::string note;
+  std::optional<selftest::SelfTest> st;
+  std::string err;
+  if (o.sim) {
+    const sim::TaskId task = sim::parse_task(o.task);  // InputError naming the valid tasks
+    if (so.budget > sim::task_horizon(task))
+      throw InputError("", "--budget", "must be at most the task horizon " + std::to_string(sim::task_horizon(task)) +
+                                           " with --sim (got " + std::to_string(so.budget) + ")");
+    const auto cal = load_calibration(o);
+    so.model = cal.model();
+    so.frame_rotation = o.frame_rotation == "identity" ? selftest::FrameRotation::kIdentity : selftest::FrameRotation::kMeasured;
+    h.backend = "Bullet simulator, calibration " + cal.sha256().substr(0, 12) + ", frame rotation " + o.frame_rotation;
+    h.unit = "m";
+    st = selftest::SelfTest::create(so, &err);
+    if (!st) throw InputError("", "selftest", err);
+    note = run_sim(*st, hidden, o);
+  } else {
+    so.frame_rotation = selftest::FrameRotation::kIdentity;  // the stand-in decodes with R = I (reference §11)
+    h.backend = "synthetic stand-in: alpha 1, sigma 0.05, R = I";
+    h.unit = "synthetic units";
+    st = selftest::SelfTest::create(so, &err);
+    if (!st) throw InputError("", "selftest", err);
+    selftest::SyntheticRobot robot(hidden, so.model, o.seed);
+    selftest::run(*st, robot);
+  }
+  h.budget = so.budget;
+  h.pool_size = static_cast<int>(st->pool().size());
+
+  selftest::Verdict v = st->verdict();
+  if (!note.empty() && v.status == selftest::Status::kPass) {  // never pass on a cut-short probe
+    v.status = selftest::Status::kInconclusive;
+    v.reason = note + ". Abstaining.";
+  } else if (!note.empty()) {
+    v.reason += " (note: " + note + ")";
+  }
+  std::cout << (o.json ? selftest::to_json(v, h) + "\n" : selftest::to_text(v, h));
+  return v.exit_code();
+}
+
+}  // namespace
+
+int run_selftest(const SelftestOptions& o) {
+  try {
+    return run(o);
+  } catch (const std::exception& e) {
+    std::cerr << "actionshift: error: " << e.what() << "\n";
+    return kSelftestBadInput;
+  }
+}
+
+}  // namespace actionshift::cli
