@@ -109,6 +109,26 @@ int run_gate1(const Gate1Options& o, std::ostream& out, std::ostream& err) {
   });
 }
 
+int run_gate_promote(const GatePromoteOptions& o, std::ostream& out, std::ostream& err) {
+  return guarded(err, [&] {
+    if (o.candidate.empty() || o.baseline.empty() || o.candidate == o.baseline)
+      throw InputError("gate promote", "--candidate/--baseline", "give two different methods");
+    const eval::ResultSet rs = eval::load_results(o.results_dir);
+    for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
+    const json j = eval::promotion_report(rs.records, o.candidate, o.baseline);
+    if (j["cells"].empty())
+      throw InputError(o.results_dir, "", "no (task, split) cell holds records of both " + o.candidate + " and " + o.baseline);
+    const std::string path = o.verdict_file.empty()
+                                 ? (fs::path(o.results_dir) / ("promotion." + o.candidate + ".vs." + o.baseline + ".json")).string()
+                                 : o.verdict_file;
+    ensure_parent(path);
+    eval::write_json_atomic(path, j);
+    if (o.json) out << j.dump(2) << "\n";
+    else out << eval::promotion_to_markdown(j) << "verdict file: " << path << "\n";
+    return kOk;
+  });
+}
+
 int run_gate_check(const GateCheckOptions& o, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
     if (o.results_dir.empty() == o.actual_file.empty())

@@ -45,6 +45,19 @@ struct GateCheckOptions {
 };
 int run_gate_check(const GateCheckOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
+// `actionshift gate promote --candidate M --baseline M' --results DIR [--json] [--verdict FILE]`
+// Applies the promotion rules (DESIGN §8) per (task, split) cell holding both methods; prints the
+// table with its evidence and writes the verdict file (default DIR/promotion.<M>.vs.<M'>.json).
+// Exit 0 (the verdicts are the output; `gate check` turns a lost promotion into exit 1).
+struct GatePromoteOptions {
+  std::string candidate;        // --candidate M
+  std::string baseline;         // --baseline M'
+  std::string results_dir;      // --results DIR
+  bool json{false};             // --json
+  std::string verdict_file;     // --verdict FILE
+};
+int run_gate_promote(const GatePromoteOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+
 // `actionshift plan --experiment FILE [--out DIR] [--plan FILE] [--slurm] [--slurm-script FILE]
 //  [--executable PATH] [--cpus-per-task N] [--time HH:MM:SS] [--partition P] [--max-parallel N]`
 // Writes the plan (default <out>/<experiment>.plan.json) and, with --slurm, an sbatch array script

@@ -107,6 +107,24 @@ std::vector<double> expected_posterior_entropy(const PoolBelief& b, const std::v
   return out;
 }
 
+std::vector<double> expected_response_magnitude(const PoolBelief& b, const std::vector<Action>& candidates, const Mat3& R,
+                                                const ProbeOptions& o) {
+  const Eigen::VectorXd p = b.probs();
+  const std::vector<int> active = active_hypotheses(p, o.max_active, o.active_mass);
+  double mass = 0;
+  for (int h : active) mass += p[h];
+  std::vector<Action> preds;
+  std::vector<double> out;
+  out.reserve(candidates.size());
+  for (const auto& c : candidates) {
+    b.preview(c, R, o.lag_aware_preview, preds);
+    double m = 0;
+    for (int h : active) m += p[h] / mass * b.model().expected(preds[static_cast<std::size_t>(h)]).norm();
+    out.push_back(m);
+  }
+  return out;
+}
+
 // ---- probing
 
 ProbingAdapter::ProbingAdapter(std::vector<Contract> pool, ResponseModel model, ProbeStrategy strategy, ProbeOptions options)
@@ -148,6 +166,12 @@ Action ProbingAdapter::encode(const Action& canonical, const Mat3& R) {
       std::size_t best = 0;
       for (std::size_t i = 1; i < eh.size(); ++i)
         if (eh[i] < eh[best]) best = i;
+      if (options_.motion_tiebreak) {
+        const auto motion = expected_response_magnitude(belief_, candidates_, R, options_);
+        const double cutoff = eh[best] + options_.entropy_tolerance;
+        for (std::size_t i = 0; i < eh.size(); ++i)
+          if (eh[i] <= cutoff && motion[i] < motion[best]) best = i;
+      }
       return candidates_[best];
     }
   }

@@ -27,6 +27,10 @@ nlohmann::json defaults(const std::string& m) {
     p["lag_aware_preview"] = true;
     p["max_active"] = 32;
   }
+  if (m == "entropy_probes") {
+    p["entropy_tolerance"] = 0.001;
+    p["motion_tiebreak"] = true;
+  }
   if (m == "dualabi") {
     p["tau"] = 1.5;  // the reference's runner value; docs/results/dualabi_pilot.md freezes ours
     p["window"] = 8;
@@ -41,6 +45,8 @@ ProbeOptions probe_options(const nlohmann::json& p) {
   if (p.contains("calibrated_preview")) o.calibrated_preview = p["calibrated_preview"].get<bool>();
   if (p.contains("lag_aware_preview")) o.lag_aware_preview = p["lag_aware_preview"].get<bool>();
   if (p.contains("max_active")) o.max_active = p["max_active"].get<int>();
+  if (p.contains("entropy_tolerance")) o.entropy_tolerance = p["entropy_tolerance"].get<double>();
+  if (p.contains("motion_tiebreak")) o.motion_tiebreak = p["motion_tiebreak"].get<bool>();
   return o;
 }
 
@@ -74,6 +80,8 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
     throw InputError("method " + method, "max_active", "must be at least 1");
   if (out.contains("tau") && !(out["tau"].get<double>() >= 0.0 && std::isfinite(out["tau"].get<double>())))
     throw InputError("method " + method, "tau", "must be finite and nonnegative");
+  if (out.contains("entropy_tolerance") && !(out["entropy_tolerance"].get<double>() >= 0.0))
+    throw InputError("method " + method, "entropy_tolerance", "must be nonnegative");
   if (out.contains("window") && out["window"].get<int>() < 1) throw InputError("method " + method, "window", "must be at least 1");
   return out;
 }

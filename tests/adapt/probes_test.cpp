@@ -204,3 +204,41 @@ TEST(ActiveSet, LargestMassFirstUntilCoveredOrCapped) {
 
 }  // namespace
 }  // namespace actionshift::adapt
+
+namespace actionshift::adapt {
+namespace {
+
+TEST(EntropyProbes, MotionTieBreakSpendsLessDisplacementOnceResolved) {
+  // once the belief is resolved every candidate is (nearly) equally informative; the tie-break then
+  // sends the pulse with the smallest expected response instead of the first candidate
+  const Contract truth = reference::representative_contracts("unseen_composition")[0];  // absolute
+  // the Bullet simulator's response (configs/calibration/pick_cube.json, rounded): per-step SNR ~ 4
+  const ResponseModel sim_like{{0.036, 0.028, 0.026, 0.038, 0.036, 0.036}, {0.008, 0.008, 0.011, 0.008, 0.021, 0.015}};
+  double motion[2] = {0, 0};
+  int right[2] = {0, 0};
+  for (int tiebreak = 0; tiebreak < 2; ++tiebreak) {
+    ProbeOptions o;
+    o.motion_tiebreak = tiebreak == 1;
+    for (int trial = 0; trial < 10; ++trial) {
+      ProbingAdapter p(reference::pool9(), sim_like, ProbeStrategy::kEntropy, o);
+      Decoder env(truth);
+      Rng rng(static_cast<std::uint64_t>(trial));
+      p.begin_episode(static_cast<std::uint64_t>(trial));
+      for (int k = 0; k < 6; ++k) {
+        const Action raw = p.encode(intent(k), Mat3::Identity());
+        const Pose6 mean = sim_like.expected(env.step(raw));
+        motion[tiebreak] += mean.norm();
+        Pose6 resp = mean;
+        for (int c = 0; c < 6; ++c) resp[c] += sim_like.sigma[static_cast<std::size_t>(c)] * rng.normal();
+        p.observe(raw, resp, Mat3::Identity());
+      }
+      right[tiebreak] += p.belief().pool()[static_cast<std::size_t>(p.belief().map_index())] == truth ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(right[0], 10);
+  EXPECT_EQ(right[1], 10);
+  EXPECT_LT(motion[1], 0.8 * motion[0]) << "with tie-break " << motion[1] << " without " << motion[0];
+}
+
+}  // namespace
+}  // namespace actionshift::adapt

@@ -56,7 +56,18 @@ struct ProbeOptions {
   int max_active{32};         ///< at most this many hypotheses enter the preview (largest mass first)
   double active_mass{1.0 - 1e-9};  ///< ... or fewer, once they hold this much of the belief
   int probe_channels{6};      ///< pose channels probed (0..5)
+  /// Entropy probing: among candidates whose expected posterior entropy is within this many nats
+  /// of the best, send the one with the smallest expected response (belief-weighted ‖α ⊙ pred‖),
+  /// so an already-resolved belief stops spending displacement. 0 with `motion_tiebreak` false is
+  /// the reference's pure argmin.
+  double entropy_tolerance{1e-3};
+  bool motion_tiebreak{true};
 };
+
+/// Belief-weighted expected magnitude of the response each candidate would cause
+/// (Σ_h p_h ‖α ⊙ pred_h‖ over the pose channels; m and rad), used by the motion tie-break.
+std::vector<double> expected_response_magnitude(const PoolBelief& belief, const std::vector<Action>& candidates,
+                                                const Mat3& R, const ProbeOptions& o);
 
 /// The 12 probe candidates in the reference's order: +a·e0 … +a·e5, −a·e0 … −a·e5 (gripper 0).
 std::vector<Action> probe_candidates(double amplitude);

@@ -1,0 +1,37 @@
+#pragma once
+// `actionshift run` (single job or plan) and `actionshift calibrate`: plain functions binding the
+// eval layer's runner to the real episode function (eval/experiment.hpp). No CLI11 here.
+
+#include "cmd_eval.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace actionshift::cli {
+
+// `actionshift run --task T --split S --method M --seed X [--episodes N] [--backbone B] [--pool P]
+//  [--params JSON] [--rotation-mode live|identity] --out DIR`  or  `actionshift run --plan FILE
+//  [--job-index I] --out DIR`; both with [--threads N] [--fsync] [--progress MODE].
+struct RunCliOptions {
+  eval::JobRequest request;        // single job (ignored with --plan)
+  std::string method_params{"{}"}; // --params: JSON object of method parameters
+  RunPlanOptions run;              // plan_file, job_index, out_dir, threads, fsync, progress
+};
+int run_run(const RunCliOptions& o);
+
+// `actionshift plan --experiment FILE ...` with the real resolver.
+int run_plan_cli(const PlanOptions& o);
+
+// `actionshift calibrate --task T [--episodes N] [--steps N] [--seed S] [--out FILE] [--json]`
+struct CalibrateOptions {
+  std::string task;
+  int episodes{16};
+  int steps{50};
+  std::uint64_t seed{20260720};
+  std::string out;   // write the calibration JSON here ("" → print it only)
+  bool json{false};  // print the calibration JSON instead of the table
+};
+int run_calibrate(const CalibrateOptions& o);
+
+}  // namespace actionshift::cli

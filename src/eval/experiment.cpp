@@ -1,0 +1,189 @@
+#include "actionshift/eval/experiment.hpp"
+
+#include "actionshift/adapt/registry.hpp"
+#include "actionshift/adapt/response.hpp"
+#include "actionshift/core/canonical_json.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/data/builtin_manifests.hpp"
+#include "actionshift/eval/calibrate.hpp"
+#include "actionshift/policy/policy.hpp"
+#include "actionshift/policy/registry.hpp"
+#include "actionshift/sim/hidden_contract_env.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <memory>
+#include <mutex>
+
+namespace actionshift::eval {
+
+namespace {
+
+Manifest manifest_of_kind(const std::string& name, bool pool) {
+  Manifest m = data::resolve_manifest(name);
+  if (m.is_pool() != pool)
+    throw InputError(name, "kind", pool ? "is a split manifest, not a pool" : "is a pool, not a split manifest");
+  return m;
+}
+
+nlohmann::json parse_params(const std::string& text, const std::string& method) {
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) throw InputError("method " + method, "params", "not a JSON object");
+  return j;
+}
+
+}  // namespace
+
+adapt::ResponseCalibration builtin_calibration(const std::string& task) {
+  const auto text = data::builtin_calibration_text(task);
+  if (!text) throw InputError("calibration", task, "no built-in calibration for this task (run `actionshift calibrate --task " + task + "`)");
+  return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + task);
+}
+
+std::string resolved_method_params(const std::string& method, const std::string& params_json) {
+  return canonical_dump(adapt::resolve_method_params(method, parse_params(params_json, method)));
+}
+
+PlanResolver default_resolver() {
+  PlanResolver r;
+  r.split = [](const std::string&, const std::string& split) {
+    const Manifest m = manifest_of_kind(split, false);
+    return SplitRef{m.name(), m.manifest_sha256(), static_cast<std::int64_t>(m.test().size())};
+  };
+  r.pool = [](const std::string& pool) {
+    const Manifest m = manifest_of_kind(pool, true);
+    return PoolRef{m.name(), m.pool_sha256()};
+  };
+  r.backbone = [](const std::string& task, const std::string& name) {
+    const auto p = policy::make_policy(name, sim::parse_task(task));
+    return BackboneRef{p->name(), p->sha256()};
+  };
+  r.calibration = [](const std::string& task, const MethodEntry& m) -> std::optional<std::string> {
+    if (!adapt::method_needs_calibration(m.name)) return std::nullopt;
+    return builtin_calibration(task).sha256();
+  };
+  r.check_method = [](const MethodEntry& m) { adapt::resolve_method_params(m.name, parse_params(m.params, m.name)); };
+  r.method_params = [](const MethodEntry& m) { return resolved_method_params(m.name, m.params); };
+  r.method_uses_pool = [](const MethodEntry& m) { return adapt::method_needs_pool(m.name); };
+  return r;
+}
+
+namespace {
+
+struct Worker {
+  std::unique_ptr<policy::Policy> policy;
+  std::map<std::int64_t, sim::HiddenContractEnv> envs;  // by contract index
+};
+
+struct Context {
+  JobSpec job;
+  std::shared_ptr<const sim::EnvModel> model;
+  std::vector<Contract> contracts;
+  std::vector<Contract> pool;
+  std::optional<adapt::ResponseModel> response;
+  adapt::TcpSlice slice;
+  std::unique_ptr<policy::Policy> prototype;
+  nlohmann::json params;
+  sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
+
+  std::mutex mutex;
+  std::map<unsigned, std::unique_ptr<Worker>> workers;
+
+  Worker& worker(unsigned index) {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto& w = workers[index];
+    if (!w) {
+      w = std::make_unique<Worker>();
+      w->policy = prototype->clone();
+    }
+    return *w;
+  }
+
+  EpisodeRecord run(const EpisodeTask& t) {
+    Worker& w = worker(t.worker);
+    const auto ci = static_cast<std::size_t>(t.contract_index);
+    const Contract& truth = contracts.at(ci);
+    auto it = w.envs.find(t.contract_index);
+    if (it == w.envs.end()) it = w.envs.emplace(t.contract_index, sim::HiddenContractEnv(model, truth, rotation)).first;
+    sim::HiddenContractEnv& env = it->second;
+
+    adapt::MethodInputs in;
+    if (job.method == "oracle") in.truth = &truth;  // the only privileged path
+    if (!pool.empty()) in.pool = &pool;
+    if (response) in.model = &*response;
+    const auto adapter = adapt::make_adapter(job.method, params, in);
+
+    Eigen::VectorXd obs = env.reset(t.episode_seed);
+    w.policy->reset();
+    adapter->begin_episode(t.episode_seed);
+    EpisodeRecord rec;
+    rec.contract_sha256 = truth.sha256();
+    for (int step = 0; step < env.horizon(); ++step) {
+      const Action intent = w.policy->act(obs);
+      const Mat3 R = rotation == sim::FrameRotation::kIdentity ? Mat3::Identity() : adapt::tcp_rotation(obs, slice);
+      const Action raw = adapter->encode(intent, R);
+      const bool probe = adapter->last_step().probe;
+      const sim::StepResult& r = env.step(raw);
+      if (r.safety != sim::SafetyFlag::kNone) break;  // the episode ended by a safety check
+      const Pose6 response_now = adapt::tcp_response(obs, r.obs, slice);
+      if (probe) {
+        ++rec.probe_steps;
+        rec.probe_displacement += response_now.head<3>().norm();
+      }
+      adapter->observe(raw, response_now, R);
+      obs = r.obs;
+      if (r.episode_over()) break;
+    }
+    const sim::EpisodeStats& st = env.episode();
+    rec.success_once = st.success_once;
+    rec.success_at_end = st.success_at_end;
+    rec.task_return = st.episode_return;
+    rec.steps = st.steps;
+    if (st.safety != sim::SafetyFlag::kNone) rec.safety_flags.emplace_back(sim::safety_flag_name(st.safety));
+    return rec;
+  }
+};
+
+}  // namespace
+
+EpisodeFn make_episode_fn(const JobSpec& job) {
+  validate_job(job);
+  auto ctx = std::make_shared<Context>();
+  ctx->job = job;
+  const sim::TaskId task = sim::parse_task(job.task);
+  ctx->model = sim::EnvModel::make(task);
+  ctx->slice = tcp_slice(ctx->model->layout());
+  ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
+
+  const Manifest split = manifest_of_kind(job.split.name, false);
+  if (split.manifest_sha256() != job.split.sha256)
+    throw InputError(job.split.name, "manifest_sha256", "is " + split.manifest_sha256() + " but the job was planned with " + job.split.sha256);
+  ctx->contracts = split.contracts();
+  if (static_cast<std::int64_t>(ctx->contracts.size()) != job.split.contracts)
+    throw InputError(job.split.name, "test", "holds a different number of contracts than the job");
+
+  if (job.pool) {
+    const Manifest pool = manifest_of_kind(job.pool->name, true);
+    if (pool.pool_sha256() != job.pool->sha256)
+      throw InputError(job.pool->name, "pool_sha256", "is " + pool.pool_sha256() + " but the job was planned with " + job.pool->sha256);
+    ctx->pool = pool.contracts();
+  } else if (adapt::method_needs_pool(job.method)) {
+    throw InputError("job", "pool", "method '" + job.method + "' needs a pool (--pool reference9|full|FILE)");
+  }
+  if (adapt::method_needs_calibration(job.method)) {
+    const auto cal = builtin_calibration(job.task);
+    if (!job.calibration_sha256 || *job.calibration_sha256 != cal.sha256())
+      throw InputError("job", "calibration_sha256", "does not match the built-in calibration of " + job.task + " (" + cal.sha256() + ")");
+    if (cal.slice.position_start != ctx->slice.position_start || cal.slice.quaternion_start != ctx->slice.quaternion_start)
+      throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
+    ctx->response = cal.model();
+  }
+  ctx->prototype = policy::make_policy(job.backbone.name, task);
+  if (ctx->prototype->sha256() != job.backbone.sha256)
+    throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
+  ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));
+  return [ctx](const EpisodeTask& t) { return ctx->run(t); };
+}
+
+}  // namespace actionshift::eval

@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# actionshift run / plan / summarize / gate1 / gate check / gate promote / calibrate, end to end on
+# the real simulator: kill-and-resume and thread-count byte equality, committed smoke verdicts,
+# and one-line errors for bad input.
+set -euo pipefail
+AS="$1"
+SRC="$2"
+source "$(dirname "$0")/lib.sh"
+
+# ---- a job is byte-identical whatever the thread count
+run "$AS" run --task pick_cube --split seen --method oracle --episodes 24 --threads 1 --out "$TMP/t1" --progress off
+expect_rc 0 "run 1 thread"
+run "$AS" run --task pick_cube --split seen --method oracle --episodes 24 --threads 2 --out "$TMP/t2" --progress off
+expect_rc 0 "run 2 threads"
+ID=$(ls "$TMP/t1" | grep '\.jsonl$')
+cmp -s "$TMP/t1/$ID" "$TMP/t2/$ID" && ok || bad "1-thread and 2-thread JSONL differ"
+[ "$(wc -l < "$TMP/t1/$ID")" = 24 ] && ok || bad "24 records expected"
+# a finished job is a no-op
+before=$(sha256sum "$TMP/t1/$ID")
+run "$AS" run --task pick_cube --split seen --method oracle --episodes 24 --threads 2 --out "$TMP/t1" --progress off
+expect_out "already complete" "re-run of a finished job"
+[ "$(sha256sum "$TMP/t1/$ID")" = "$before" ] && ok || bad "re-run changed the file"
+
+# ---- SIGKILL mid-run, resume, compare with the uninterrupted run
+"$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
+  --out "$TMP/full" --progress off > /dev/null 2>&1
+"$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
+  --out "$TMP/kill" --progress off > /dev/null 2>&1 &
+PID=$!
+for _ in $(seq 1 200); do
+  n=$(cat "$TMP"/kill/*.jsonl 2>/dev/null | wc -l || true)
+  [ "${n:-0}" -ge 10 ] && break
+  sleep 0.02
+done
+kill -9 "$PID" 2>/dev/null || true
+wait "$PID" 2>/dev/null || true
+KID=$(ls "$TMP/full" | grep '\.jsonl$')
+killed_lines=$(wc -l < "$TMP/kill/$KID" || echo 0)
+[ "$killed_lines" -lt 96 ] && ok || bad "the job finished before it was killed ($killed_lines lines)"
+run "$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 1 \
+  --out "$TMP/kill" --progress off
+expect_rc 0 "resume after SIGKILL"
+cmp -s "$TMP/full/$KID" "$TMP/kill/$KID" && ok || bad "resumed JSONL differs from the uninterrupted run"
+
+# ---- smoke plan, Gate 1 and the committed expected verdicts
+run "$AS" plan --experiment "$SRC/configs/experiments/smoke.yaml" --out "$TMP/smoke"
+expect_rc 0 "plan smoke"
+run "$AS" run --plan "$TMP/smoke/smoke.plan.json" --out "$TMP/smoke" --progress off
+expect_rc 0 "run smoke plan"
+run "$AS" gate1 --results "$TMP/smoke"
+expect_out "pick_cube" "gate1 table"
+run "$AS" gate check --expected "$SRC/configs/gates/gate1/smoke.verdict.json" --results "$TMP/smoke"
+expect_rc 0 "gate check smoke"
+expect_out "no verdict regressions" "gate check smoke output"
+# a regression is exit 1: remove the oracle's successes from the results
+mkdir -p "$TMP/broken"
+for f in "$TMP"/smoke/*.jsonl; do sed 's/"success_once":true/"success_once":false/' "$f" > "$TMP/broken/$(basename "$f")"; done
+run "$AS" gate check --expected "$SRC/configs/gates/gate1/smoke.verdict.json" --results "$TMP/broken"
+expect_rc 1 "gate check regression"
+expect_out "REGRESSION" "gate check names the regression"
+
+# ---- summarize and promote
+run "$AS" summarize "$TMP/smoke" --json
+expect_rc 0 "summarize"
+run "$AS" gate promote --candidate oracle --baseline no_adapt --results "$TMP/smoke"
+expect_rc 0 "gate promote"
+expect_out "extend_seeds" "one seed: more seeds needed"
+
+# ---- bad input: one line, exit 2, nothing written over
+run "$AS" run --task pick_cube --split seen --method telepathy --out "$TMP/x" --progress off
+expect_rc 2 "unknown method"
+expect_one_line_error "unknown method"
+expect_err "unknown method" "unknown method message"
+run "$AS" run --task pick_cube --split no_such_split --method oracle --out "$TMP/x" --progress off
+expect_rc 2 "missing manifest"
+expect_one_line_error "missing manifest"
+run "$AS" run --task pick_cube --split seen --method entropy_probes --out "$TMP/x" --progress off
+expect_rc 2 "pool method without a pool"
+expect_err "needs a pool" "pool method without a pool message"
+cp "$TMP/t1/$ID" "$TMP/corrupt.jsonl"
+sed -i '5s/.*/{"this is": "not a record"}/' "$TMP/t1/$ID"
+before=$(sha256sum "$TMP/t1/$ID")
+run "$AS" run --task pick_cube --split seen --method oracle --episodes 24 --threads 2 --out "$TMP/t1" --progress off
+expect_rc 2 "corrupt results file"
+expect_one_line_error "corrupt results file"
+[ "$(sha256sum "$TMP/t1/$ID")" = "$before" ] && ok || bad "a corrupt results file was modified"
+
+# ---- calibrate reproduces the committed calibration
+run "$AS" calibrate --task pick_cube --json
+expect_rc 0 "calibrate"
+[ "$OUT" = "$(cat "$SRC/configs/calibration/pick_cube.json")" ] && ok || bad "calibrate does not reproduce configs/calibration/pick_cube.json"
+
+finish
