@@ -2,6 +2,7 @@
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
 #include "cmd_policy.hpp"
+#include "cmd_run.hpp"
 #include "cmd_selftest.hpp"
 #include "commands.hpp"
 
@@ -84,6 +85,37 @@ int main(int argc, char** argv) {
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
   bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
 
+  // ---- selftest (plug-and-verify; its own exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input)
+  cli::SelftestOptions st_o;
+  auto* st = app.add_subcommand(
+      "selftest",
+      "Plug-and-verify self-test: probe with bounded pulses, identify the action wiring over a declared pool\n"
+      "and answer PASS, MISMATCH (with the diff in words) or INCONCLUSIVE (abstain). Contract arguments: a\n"
+      "library name, MANIFEST:INDEX (e.g. reference_seen:0), a file with contract JSON, or inline JSON.\n"
+      "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
+  st->add_option("--task", st_o.task, "Task (with --sim: pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side)")
+      ->capture_default_str();
+  auto* st_demo = st->add_option("--demo", st_o.demo,
+                                 "Synthetic demo wiring: identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled");
+  st->add_option("--hidden-contract", st_o.hidden_contract, "The robot's true wiring (default: the expected contract)")
+      ->excludes(st_demo);
+  st->add_option("--expected", st_o.expected, "The wiring the policy assumes")->capture_default_str();
+  st->add_flag("--sim", st_o.sim, "Probe the Bullet environment of --task instead of the synthetic stand-in");
+  st->add_option("--calibration", st_o.calibration, "--sim: response calibration JSON (default: the task's built-in one)");
+  st->add_option("--frame-rotation", st_o.frame_rotation, "--sim: live (TCP orientation) or identity")->capture_default_str();
+  st->add_option("--pool", st_o.pools,
+                 "Declared pool: library, a manifest name or file (repeatable; default library, with --sim library + reference9)");
+  st->add_option("--strategy", st_o.strategy, "Probe strategy: fixed or entropy")->capture_default_str();
+  st->add_option("--budget", st_o.budget, "Probe steps (default 6, also with --sim: docs/selftest.md)");
+  st->add_option("--amplitude", st_o.amplitude, "Probe bound per pose channel, in (0, 1] (default 0.5)");
+  st->add_option("--confidence-floor", st_o.confidence_floor, "Per-field confidence needed to resolve a field")
+      ->capture_default_str();
+  st->add_option("--misspec-ratio", st_o.misspec_ratio, "Abstain when the best fit exceeds this many times the noise")
+      ->capture_default_str();
+  st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
+  st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
+  st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
+
   // ---- train bc | gate0 (policy layer)
   auto* train = app.add_subcommand("train", "Train backbones");
   train->require_subcommand(1);
@@ -119,36 +151,113 @@ int main(int argc, char** argv) {
   gate0->add_flag("--progress,!--quiet", gate0_o.progress, "No progress on stderr");
   gate0->callback([&] { action = [&] { return cli::run_gate0(gate0_o); }; });
 
-  // ---- selftest (plug-and-verify; its own exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input)
-  cli::SelftestOptions st_o;
-  auto* st = app.add_subcommand(
-      "selftest",
-      "Plug-and-verify self-test: probe with bounded pulses, identify the action wiring over a declared pool\n"
-      "and answer PASS, MISMATCH (with the diff in words) or INCONCLUSIVE (abstain). Contract arguments: a\n"
-      "library name, MANIFEST:INDEX (e.g. reference_seen:0), a file with contract JSON, or inline JSON.\n"
-      "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
-  st->add_option("--task", st_o.task, "Task (with --sim: pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side)")
+  // ---- run | plan | summarize | gate1 | gate check | calibrate (eval layer)
+  cli::RunCliOptions run_o;
+  std::int64_t run_job_index = -1;
+  auto* run = app.add_subcommand(
+      "run",
+      "Run an evaluation job: episodes of a backbone under each contract of a split, through a method's\n"
+      "adapter, written as one JSONL record per episode to <out>/<job id>.jsonl (+ .summary.json). The job\n"
+      "id is the SHA-256 of everything that determines the episodes; a finished job is a no-op and a killed\n"
+      "one resumes. Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
+  run->add_option("--task", run_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
+  run->add_option("--split", run_o.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
+  run->add_option("--method", run_o.request.method.name,
+                  "oracle, no_adapt, exact_belief, fixed_probes, random_probes, entropy_probes, dualabi");
+  run->add_option("--params", run_o.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
       ->capture_default_str();
-  auto* st_demo = st->add_option("--demo", st_o.demo,
-                                 "Synthetic demo wiring: identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled");
-  st->add_option("--hidden-contract", st_o.hidden_contract, "The robot's true wiring (default: the expected contract)")
-      ->excludes(st_demo);
-  st->add_option("--expected", st_o.expected, "The wiring the policy assumes")->capture_default_str();
-  st->add_flag("--sim", st_o.sim, "Probe the Bullet environment of --task instead of the synthetic stand-in");
-  st->add_option("--calibration", st_o.calibration, "--sim: response calibration JSON (default: the task's built-in one)");
-  st->add_option("--frame-rotation", st_o.frame_rotation, "--sim: live (TCP orientation) or identity")->capture_default_str();
-  st->add_option("--pool", st_o.pools,
-                 "Declared pool: library, a manifest name or file (repeatable; default library, with --sim library + reference9)");
-  st->add_option("--strategy", st_o.strategy, "Probe strategy: fixed or entropy")->capture_default_str();
-  st->add_option("--budget", st_o.budget, "Probe steps (default 6, also with --sim: docs/selftest.md)");
-  st->add_option("--amplitude", st_o.amplitude, "Probe bound per pose channel, in (0, 1] (default 0.5)");
-  st->add_option("--confidence-floor", st_o.confidence_floor, "Per-field confidence needed to resolve a field")
+  run->add_option("--seed", run_o.request.seed, "Experimental seed")->capture_default_str();
+  run->add_option("--episodes", run_o.request.episodes, "Episodes (dealt round-robin over the split's contracts)")
       ->capture_default_str();
-  st->add_option("--misspec-ratio", st_o.misspec_ratio, "Abstain when the best fit exceeds this many times the noise")
+  run->add_option("--backbone", run_o.request.backbone, "Frozen policy: expert, mlp, external:<command>, ...")
       ->capture_default_str();
-  st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
-  st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
-  st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
+  run->add_option("--pool", run_o.request.pool, "Declared pool for pool-belief methods: reference9, full or a file");
+  run->add_option("--rotation-mode", run_o.request.rotation_mode, "Tool-frame rotation: live (TCP) or identity")
+      ->capture_default_str();
+  run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
+  run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)");
+  run->add_option("--out", run_o.run.out_dir, "Results directory")->capture_default_str();
+  run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores)")->capture_default_str();
+  run->add_flag("--fsync", run_o.run.fsync, "fsync after every record");
+  run->add_option("--progress", run_o.run.progress, "auto, bar, lines or off")->capture_default_str();
+  run->callback([&] {
+    action = [&] {
+      if (run_job_index >= 0) run_o.run.job_index = run_job_index;
+      if (run_o.run.plan_file.empty() &&
+          (run_o.request.task.empty() || run_o.request.split.empty() || run_o.request.method.name.empty())) {
+        std::cerr << "actionshift: error: run needs --task, --split and --method, or --plan (see --help)\n";
+        return static_cast<int>(cli::kBadInput);
+      }
+      return cli::run_run(run_o);
+    };
+  });
+
+  cli::PlanOptions plan_o;
+  auto* plan = app.add_subcommand(
+      "plan", "Expand an experiment (configs/experiments/<name>.yaml) into its job list; --slurm also writes an\n"
+              "sbatch array script with one array task per job (each runs `actionshift run --plan ... --job-index`).");
+  plan->add_option("--experiment", plan_o.experiment_file, "Experiment YAML")->required();
+  plan->add_option("--out", plan_o.out_dir, "Results directory of the jobs")->capture_default_str();
+  plan->add_option("--plan", plan_o.plan_file, "Plan file (default <out>/<experiment>.plan.json)");
+  plan->add_flag("--slurm", plan_o.slurm, "Also write a Slurm array script");
+  plan->add_option("--slurm-script", plan_o.slurm_file, "Script path (default <out>/<experiment>.sbatch)");
+  plan->add_option("--executable", plan_o.executable, "The actionshift binary the array tasks call")->capture_default_str();
+  plan->add_option("--cpus-per-task", plan_o.cpus_per_task, "Slurm --cpus-per-task")->capture_default_str();
+  plan->add_option("--time", plan_o.time_limit, "Slurm --time")->capture_default_str();
+  plan->add_option("--partition", plan_o.partition, "Slurm --partition");
+  plan->add_option("--max-parallel", plan_o.max_parallel, "Array throttle (%N)");
+  plan->callback([&] { action = [&] { return cli::run_plan_cli(plan_o); }; });
+
+  cli::SummarizeOptions sum_o;
+  auto* summarize = app.add_subcommand("summarize", "Merge every <id>.jsonl in a directory into per-cell tables (Markdown or JSON)");
+  summarize->add_option("dir", sum_o.results_dir, "Results directory")->required();
+  summarize->add_flag("--json", sum_o.json, "Print JSON instead of Markdown");
+  summarize->add_option("--out", sum_o.out_file, "Also write the JSON summary to this file");
+  summarize->callback([&] { action = [&] { return cli::run_summarize(sum_o); }; });
+
+  cli::Gate1Options g1_o;
+  auto* gate1 = app.add_subcommand(
+      "gate1", "Gate 1 (privileged ceiling vs no adaptation): per task and split, oracle and no_adapt success with\n"
+               "Wilson intervals and their paired bootstrap difference; writes a verdict file; exit 1 if a gated cell fails.");
+  gate1->add_option("--results", g1_o.results_dir, "Results directory")->required();
+  gate1->add_flag("--json", g1_o.json, "Print JSON");
+  gate1->add_option("--verdict", g1_o.verdict_file, "Verdict file (default <results>/gate1.verdict.json)");
+  gate1->add_option("--samples", g1_o.samples, "Bootstrap resamples")->capture_default_str();
+  gate1->add_option("--bootstrap-seed", g1_o.bootstrap_seed, "Bootstrap seed")->capture_default_str();
+  gate1->callback([&] { action = [&] { return cli::run_gate1(g1_o); }; });
+
+  auto* gate = app.add_subcommand("gate", "Compare gate verdicts with committed expectations (CI)");
+  gate->require_subcommand(1);
+  cli::GateCheckOptions gc_o;
+  auto* gate_check = gate->add_subcommand(
+      "check", "Recompute verdicts from --results (or read --actual) and exit 1 if an expected pass regressed");
+  gate_check->add_option("--expected", gc_o.expected_file, "Committed verdict file")->required();
+  gate_check->add_option("--results", gc_o.results_dir, "Results directory to recompute from");
+  gate_check->add_option("--actual", gc_o.actual_file, "A verdict file to compare instead");
+  gate_check->callback([&] { action = [&] { return cli::run_gate_check(gc_o); }; });
+  cli::GatePromoteOptions gp_o;
+  auto* gate_promote = gate->add_subcommand(
+      "promote", "Promotion gate (DESIGN §8): a candidate method vs its matched baseline per task and split: >= 5 points\n"
+                 "(paired 95 % bootstrap interval above 0) or a success-vs-probe-cost Pareto point, without a safety\n"
+                 "regression; a one-seed result under 0.3 is never promoted; < 3 matched seeds: extend_seeds.");
+  gate_promote->add_option("--candidate", gp_o.candidate, "Candidate method")->required();
+  gate_promote->add_option("--baseline", gp_o.baseline, "Matched baseline method")->required();
+  gate_promote->add_option("--results", gp_o.results_dir, "Results directory")->required();
+  gate_promote->add_flag("--json", gp_o.json, "Print the verdict file");
+  gate_promote->add_option("--verdict", gp_o.verdict_file, "Verdict file (default <results>/promotion.<c>.vs.<b>.json)");
+  gate_promote->callback([&] { action = [&] { return cli::run_gate_promote(gp_o); }; });
+
+  cli::CalibrateOptions cal_o;
+  auto* calibrate = app.add_subcommand(
+      "calibrate", "Measure each pose channel's response gain, noise and R^2 on the unwrapped environment with\n"
+                   "random actions (the likelihood of the belief adapters); prints the table, --out writes the JSON.");
+  calibrate->add_option("--task", cal_o.task, "Task")->required();
+  calibrate->add_option("--episodes", cal_o.episodes, "Episodes of random actions")->capture_default_str();
+  calibrate->add_option("--steps", cal_o.steps, "Steps per episode (at most the horizon)")->capture_default_str();
+  calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
+  calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<task>.json)");
+  calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
+  calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
 
   try {
     app.parse(argc, argv);
