@@ -65,18 +65,23 @@ inline bool is_rotation(const Mat3& R, std::string* why = nullptr) {
 /// Allocation-free.
 inline Action decode(const Contract& c, const Action& raw, const Mat3& R, const Pose6& tracked_target,
                      Pose6* next_target = nullptr) {
-  Pose6 pose = decode_pose(c, raw.head<kPoseDim>());
+  const auto& p = c.permutation();
+  const auto& g = c.gain();
+  Vec3 t(raw[p[0]] * g[0], raw[p[1]] * g[1], raw[p[2]] * g[2]);
+  Vec3 r(raw[p[3]] * g[3], raw[p[4]] * g[4], raw[p[5]] * g[5]);
   if (c.frame() == Frame::kTool) {
-    pose.head<3>() = R * pose.head<3>().eval();
-    pose.tail<3>() = R * pose.tail<3>().eval();
+    t = R * t;
+    r = R * r;
   }
   Action out;
   if (c.target() == Target::kAbsolute) {
-    out.head<kPoseDim>() = pose - tracked_target;
-    if (next_target) *next_target = pose;
+    out.head<3>() = t - tracked_target.head<3>();
+    out.segment<3>(3) = r - tracked_target.tail<3>();
+    if (next_target) *next_target << t, r;
   } else {
-    out.head<kPoseDim>() = pose;
-    if (next_target) *next_target = tracked_target + pose;
+    out.head<3>() = t;
+    out.segment<3>(3) = r;
+    if (next_target) *next_target = tracked_target + out.head<kPoseDim>();
   }
   out[kGripper] = c.gripper_inverted() ? -raw[kGripper] : raw[kGripper];
   return out;
@@ -85,14 +90,24 @@ inline Action decode(const Contract& c, const Action& raw, const Mat3& R, const 
 /// Exact inverse of decode(): the raw action that decodes to `canonical` under the same R and
 /// tracked target (the oracle's path).
 inline Action encode(const Contract& c, const Action& canonical, const Mat3& R, const Pose6& tracked_target) {
-  Pose6 semantic = canonical.head<kPoseDim>();
-  if (c.target() == Target::kAbsolute) semantic += tracked_target;
-  if (c.frame() == Frame::kTool) {
-    semantic.head<3>() = R.transpose() * semantic.head<3>().eval();
-    semantic.tail<3>() = R.transpose() * semantic.tail<3>().eval();
+  Vec3 t = canonical.head<3>();
+  Vec3 r = canonical.segment<3>(3);
+  if (c.target() == Target::kAbsolute) {
+    t += tracked_target.head<3>();
+    r += tracked_target.tail<3>();
   }
+  if (c.frame() == Frame::kTool) {
+    t = R.transpose() * t;
+    r = R.transpose() * r;
+  }
+  const auto& p = c.permutation();
+  const auto& g = c.gain();
   Action raw;
-  raw.head<kPoseDim>() = encode_pose(c, semantic);
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    raw[p[k]] = t[i] / g[k];
+    raw[p[k + 3]] = r[i] / g[k + 3];
+  }
   raw[kGripper] = c.gripper_inverted() ? -canonical[kGripper] : canonical[kGripper];
   return raw;
 }
