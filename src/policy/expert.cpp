@@ -18,6 +18,7 @@ using detail::yaw_of;
 using sim::TaskId;
 
 constexpr double kCubeHalf = 0.02;  // [m] every cube task (facts section 1)
+constexpr double kGraspYawTolerance = 0.4;               // [rad] closing on a cube this far off its faces still works
 constexpr double kRestYaw = 0.0;                         // hand yaw of the rest pose (pick, push, pull)
 constexpr double kStackRestYaw = std::numbers::pi / 2;  // stack: joint 7 = -pi/4 turns the hand a quarter
 
@@ -83,12 +84,14 @@ Action grasp_cube(const Eigen::Isometry3d& tcp, const Eigen::Isometry3d& cube, d
   // fingers closed on nothing: open again where we are (lifting a little)
   if (opening <= 0.025) return move_to(tcp, tcp.translation() + Eigen::Vector3d(0, 0, 0.01), r, 1.0);
   // above the cube and aligned: descend; otherwise approach from above
-  if (xy_err < 0.008 && yaw_err < 0.25) {
+  if (xy_err < 0.008 && yaw_err < kGraspYawTolerance) {
     if (near) return move_to(tcp, c, r, -1.0);
     return move_to(tcp, c, r, 1.0);
   }
-  // hover above the cube while turning; come down to 3 cm above it once over it
-  const double hover = c.z() + (xy_err > 0.03 ? 0.06 : 0.03);
+  // hover above the cube while turning; once over it, come down as the yaw error shrinks
+  // (continuous in the yaw error, so a learner does not stall at a hover height)
+  const double lower = std::clamp((yaw_err - kGraspYawTolerance) / 0.3, 0.0, 1.0);
+  const double hover = c.z() + (xy_err > 0.03 ? 0.06 : 0.005 + 0.025 * lower);
   const double z = xy_err > 0.03 ? std::max(hover, std::min(tcp.translation().z(), hover + 0.05)) : hover;
   const Eigen::Vector3d above(c.x(), c.y(), z);
   return move_to(tcp, above, r, 1.0);

@@ -44,13 +44,11 @@ struct ExternalPolicy::Process {
   ~Process() {
     if (to_child >= 0) close(to_child);
     if (from_child >= 0) close(from_child);
-    if (pid <= 0 || exited) return;
-    // give it up to 2 s to exit after stdin is closed, then kill
+    if (pid <= 0) return;
+    // give it up to 2 s to exit after stdin is closed, then kill its process group
     for (int i = 0; i < 200 && !poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (!exited) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-    }
+    kill(-pid, SIGKILL);
+    if (!exited) waitpid(pid, &status, 0);
   }
 };
 
@@ -81,7 +79,13 @@ ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOp
   posix_spawn_file_actions_adddup2(&fa, out_pipe[1], STDOUT_FILENO);
   std::string sh = "sh", dash_c = "-c";
   char* argv[] = {sh.data(), dash_c.data(), command_.data(), nullptr};
-  const int rc = posix_spawn(&proc_->pid, "/bin/sh", &fa, nullptr, argv, environ);
+  // own process group, so that a kill also reaches whatever the shell started
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);
+  const int rc = posix_spawn(&proc_->pid, "/bin/sh", &fa, &attr, argv, environ);
+  posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&fa);
   close(in_pipe[0]);
   close(out_pipe[1]);

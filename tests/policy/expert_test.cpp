@@ -60,7 +60,7 @@ TEST(Expert, RejectsAWrongSizedObservation) {
 
 TEST(Expert, HashIdentifiesVersionAndTask) {
   auto a = policy::make_expert(sim::TaskId::kPickCube), b = policy::make_expert(sim::TaskId::kPushCube);
-  EXPECT_EQ(a->sha256(), sha256_hex("actionshift-expert-v2/pick_cube"));
+  EXPECT_EQ(a->sha256(), sha256_hex("actionshift-expert-v3/pick_cube"));
   EXPECT_NE(a->sha256(), b->sha256());
   EXPECT_EQ(a->name(), "expert");
 }

@@ -19,9 +19,9 @@
 namespace actionshift::policy {
 
 /// Version of the scripted experts' behaviour (bump when any expert changes).
-inline constexpr std::string_view kExpertVersion = "actionshift-expert-v2";
+inline constexpr std::string_view kExpertVersion = "actionshift-expert-v3";
 
-/// "actionshift-expert-v2/<task>": the string whose SHA-256 identifies the expert of `task`.
+/// "actionshift-expert-v3/<task>": the string whose SHA-256 identifies the expert of `task`.
 std::string expert_identity(sim::TaskId task);
 
 /// The stateless expert's action for one observation of `task` (obs layout: sim::observation_layout).

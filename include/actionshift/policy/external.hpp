@@ -11,7 +11,7 @@
 ///   -> {"type":"step","t":0,"obs":[42 numbers]}
 ///   <- {"action":[7 numbers]}                            (within the step timeout)
 ///   ...
-///   (end: stdin is closed; the process should exit; it is killed after 2 s)
+///   (end: stdin is closed; the process should exit; its process group is killed after 2 s)
 ///
 /// The command runs under `/bin/sh -c`; its stderr is passed through. The process is started
 /// when the policy is constructed (one process per clone, so one per worker thread). A process
