@@ -7,12 +7,16 @@
 #include "actionshift/policy/mlp.hpp"
 
 #include <cstdlib>
+#include <filesystem>
+#include <system_error>
 
 namespace actionshift::policy {
 
 std::string default_backbones_dir() {
   if (const char* env = std::getenv("ACTIONSHIFT_BACKBONES_DIR"); env != nullptr && *env != '\0') return env;
-  return ACTIONSHIFT_DEFAULT_BACKBONES_DIR;
+  std::error_code ec;
+  if (std::filesystem::is_directory(ACTIONSHIFT_DEFAULT_BACKBONES_DIR, ec)) return ACTIONSHIFT_DEFAULT_BACKBONES_DIR;
+  return ACTIONSHIFT_INSTALLED_BACKBONES_DIR;
 }
 
 std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const std::string& backbones_dir) {

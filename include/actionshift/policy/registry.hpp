@@ -19,7 +19,7 @@
 namespace actionshift::policy {
 
 /// Where committed MLP weights are looked up: $ACTIONSHIFT_BACKBONES_DIR if set, else the source
-/// tree's configs/backbones (compiled in).
+/// tree's configs/backbones if it exists, else the installed <datadir>/actionshift/backbones.
 std::string default_backbones_dir();
 
 /// Options of make_policy.
