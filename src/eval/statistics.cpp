@@ -8,32 +8,6 @@
 
 namespace actionshift::eval {
 
-WilsonInterval wilson_interval(std::int64_t successes, std::int64_t total, double z, double confidence) {
-  if (total <= 0)
-    throw std::invalid_argument("wilson_interval: at least one trial is required (got total " +
-                                std::to_string(total) + ")");
-  if (successes < 0 || successes > total)
-    throw std::invalid_argument("wilson_interval: successes must be in [0, total] (got " +
-                                std::to_string(successes) + " of " + std::to_string(total) + ")");
-  if (!(confidence > 0.0 && confidence < 1.0))
-    throw std::invalid_argument("wilson_interval: confidence must be in (0, 1)");
-  // same operation order as the reference's Python, so results agree to the last bit
-  const double n = static_cast<double>(total);
-  const double p = static_cast<double>(successes) / n;
-  const double z2 = z * z;
-  const double denominator = 1.0 + z2 / n;
-  const double centre = (p + z2 / (2.0 * n)) / denominator;
-  const double half = z * std::sqrt(p * (1.0 - p) / n + z2 / (4.0 * n * n)) / denominator;
-  WilsonInterval w;
-  w.successes = successes;
-  w.total = total;
-  w.rate = p;
-  w.lower = centre - half;
-  w.upper = centre + half;
-  w.confidence = confidence;
-  return w;
-}
-
 std::uint64_t BoundedRng::below(std::uint64_t n) {
   if (n == 0) throw std::invalid_argument("BoundedRng::below: n must be positive");
   // reject the top (2^64 mod n) values so every residue is equally likely

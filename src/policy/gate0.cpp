@@ -28,13 +28,7 @@ nlohmann::json wilson_json(const Wilson& w) {
 Wilson wilson(std::int64_t s, std::int64_t n) {
   if (n <= 0) throw std::invalid_argument("at least one episode is required");
   if (s < 0 || s > n) throw std::invalid_argument("successes must lie in [0, total]");
-  const double z = kGate0Z95;
-  const double nn = static_cast<double>(n);
-  const double p = static_cast<double>(s) / nn;
-  const double d = 1.0 + z * z / nn;
-  const double centre = (p + z * z / (2.0 * nn)) / d;
-  const double half = z * std::sqrt(p * (1.0 - p) / nn + z * z / (4.0 * nn * nn)) / d;
-  return Wilson{s, n, p, centre - half, centre + half, 0.95};
+  return actionshift::wilson_interval(s, n);
 }
 
 double gate0_floor(sim::TaskId task) { return task == sim::TaskId::kPegInsertionSide ? 0.2 : 0.5; }

@@ -57,63 +57,6 @@ TEST(Superiority, NeedsThreeDistinctSeeds) {
 
 // ---- Gate 0
 
-TEST(Gate0, CompetenceFloorsAndReasonStrings) {
-  EXPECT_EQ(competence_floor("pick_cube"), 0.5);
-  EXPECT_EQ(competence_floor("stack_cube"), 0.5);
-  EXPECT_EQ(competence_floor("peg_insertion_side"), 0.2);
-  const auto point = competence_verdict("pick_cube", 40, 100, 0.5, CompetenceRule::point_estimate);
-  EXPECT_FALSE(point.passed);
-  EXPECT_EQ(point.reason, "success 0.4000 below floor 0.5000");
-  EXPECT_TRUE(competence_verdict("peg_insertion_side", 25, 100, competence_floor("peg_insertion_side"),
-                                 CompetenceRule::point_estimate).passed);
-  // 52/100 passes on the point estimate but not on the Wilson lower bound (0.4231)
-  EXPECT_TRUE(competence_verdict("pick_cube", 52, 100, 0.5, CompetenceRule::point_estimate).passed);
-  const auto lower = competence_verdict("pick_cube", 52, 100);
-  EXPECT_FALSE(lower.passed);
-  EXPECT_EQ(lower.reason, "success Wilson lower bound " + fixed(wilson_interval(52, 100).lower, 4) + " below floor 0.5000");
-  EXPECT_TRUE(competence_verdict("pick_cube", 300, 300).passed);
-  EXPECT_THAT([] { competence_verdict("pick_cube", 0, 0); },
-              ThrowsMessage<std::invalid_argument>(HasSubstr("at least one episode is required")));
-}
-
-TEST(Gate0, ParityRulesReportedSeparately) {
-  const auto by_points = parity_verdict(75, 100, 73, 100);
-  EXPECT_TRUE(by_points.passed);
-  EXPECT_TRUE(by_points.two_point_rule);
-  const auto by_overlap = parity_verdict(6, 10, 8, 10);
-  EXPECT_TRUE(by_overlap.passed);
-  EXPECT_FALSE(by_overlap.two_point_rule);
-  EXPECT_TRUE(by_overlap.overlap_rule);
-  EXPECT_NEAR(by_overlap.absolute_difference, 0.2, 1e-12);
-  const auto fail = parity_verdict(90, 100, 50, 100);
-  EXPECT_FALSE(fail.passed);
-  EXPECT_FALSE(fail.two_point_rule);
-  EXPECT_FALSE(fail.overlap_rule);
-  EXPECT_EQ(fail.reason, "absolute success difference 0.4000 exceeds 0.0200 and CIs do not overlap");
-  EXPECT_THAT([] { parity_verdict(0, 0, 1, 1); },
-              ThrowsMessage<std::invalid_argument>(HasSubstr("at least one episode is required")));
-}
-
-TEST(Gate0, VerdictOverRecordSets) {
-  const auto unwrapped = make_records("pick_cube", "identity", "unwrapped", {20260718}, 300, [](int k) { return k % 50 != 0; });
-  const auto identity = make_records("pick_cube", "identity", "identity", {20260718}, 300, [](int k) { return k % 60 != 0; });
-  const auto broken = make_records("pick_cube", "identity", "identity", {20260718}, 300, [](int k) { return k % 2 == 0; });
-  const auto ok = gate0_verdict("expert", "pick_cube", unwrapped, identity);
-  EXPECT_TRUE(ok.passed);
-  EXPECT_EQ(ok.decision, "advance");
-  EXPECT_EQ(ok.competence.interval.successes, 294);
-  const auto bad = gate0_verdict("expert", "pick_cube", unwrapped, broken);
-  EXPECT_EQ(bad.decision, "exclude");
-  EXPECT_THAT(bad.reason, HasSubstr("identity parity: absolute success difference 0.4800 exceeds 0.0200"));
-  const auto weak = make_records("pick_cube", "identity", "unwrapped", {20260718}, 300, [](int k) { return k % 3 == 0; });
-  EXPECT_THAT(gate0_verdict("mlp", "pick_cube", weak, weak).reason, HasSubstr("competence: success Wilson lower bound"));
-  const auto j = gate0_to_json({ok, bad});
-  EXPECT_EQ(j["gate"], "gate0");
-  EXPECT_EQ(j["cells"]["expert/pick_cube"]["verdict"], "fail");  // the later verdict of the same key wins
-  EXPECT_EQ(j["passed"], false);
-  EXPECT_EQ(gate0_to_json({ok})["cells"]["expert/pick_cube"]["identity_parity"]["two_point_rule"], true);
-}
-
 // ---- Gate 1
 
 std::vector<EpisodeRecord> gate1_records(int n, std::vector<std::uint64_t> seeds = kSeeds) {

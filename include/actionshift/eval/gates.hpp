@@ -1,6 +1,5 @@
 #pragma once
-/// \file Gates computed by code (DESIGN §8; reference §8): Gate 0 (backbone competence and wrapper
-/// parity), Gate 1 (privileged ceiling: oracle vs no adaptation), promotion rules, and the
+/// \file Gates computed by code (DESIGN §8; reference §8): Gate 1 (privileged ceiling: oracle vs no adaptation), promotion rules, and the
 /// comparison of verdict files that CI uses to catch regressions.
 
 #include "actionshift/eval/record.hpp"
@@ -33,80 +32,7 @@ BootstrapInterval paired_difference(const std::vector<EpisodeRecord>& candidate,
 /// True iff at least three distinct seeds are given (superiority needs three matched seeds).
 bool superiority_allowed(const std::vector<std::uint64_t>& seeds);
 
-// ---------------------------------------------------------------------------------------------
-// Gate 0: competence floor and wrapper parity (issue 4; reference §8.1)
-
-/// Default competence floor (issue 4).
-inline constexpr double kDefaultCompetenceFloor = 0.5;
-/// Largest absolute success difference for the two-point parity rule (reference: 2 percentage points).
-inline constexpr double kParityTolerance = 0.02;
-
-/// The reference's per-task floors: 0.50 for the cube tasks, 0.20 for peg_insertion_side;
-/// kDefaultCompetenceFloor for any other task.
-double competence_floor(std::string_view task);
-
-/// Which statistic is compared with the competence floor.
-enum class CompetenceRule {
-  wilson_lower,    ///< the Wilson 95 % lower bound must reach the floor (default: a claim with its uncertainty)
-  point_estimate,  ///< the success rate must reach the floor (the reference's rule)
-};
-
-/// Competence of a backbone on a task.
-struct CompetenceVerdict {
-  std::string task;
-  double floor{0.0};
-  CompetenceRule rule{CompetenceRule::wilson_lower};
-  WilsonInterval interval;   ///< success_once with its Wilson interval
-  bool passed{false};
-  std::string reason;        ///< failure: reference string (see competence_verdict); pass: empty
-};
-
-/// Pass iff the chosen statistic ≥ floor. Failure reasons: point_estimate
-/// "success {rate:.4f} below floor {floor:.4f}" (the reference's string); wilson_lower
-/// "success Wilson lower bound {lower:.4f} below floor {floor:.4f}".
-/// Throws std::invalid_argument "at least one episode is required" for total 0.
-CompetenceVerdict competence_verdict(std::string_view task, std::int64_t successes, std::int64_t total,
-                                     double floor = kDefaultCompetenceFloor,
-                                     CompetenceRule rule = CompetenceRule::wilson_lower);
-
-/// Wrapper parity between a reference (unwrapped) and a wrapped run.
-struct ParityVerdict {
-  WilsonInterval reference;          ///< unwrapped success_once
-  WilsonInterval wrapped;            ///< wrapped success_once
-  double tolerance{kParityTolerance};
-  double absolute_difference{0.0};   ///< |reference.rate − wrapped.rate|
-  bool two_point_rule{false};        ///< absolute_difference ≤ tolerance (+1e-12)
-  bool overlap_rule{false};          ///< the Wilson intervals overlap
-  bool passed{false};                ///< two_point_rule OR overlap_rule (alternatives, reference §8.1)
-  std::string reason;                ///< failure: "absolute success difference {d:.4f} exceeds {tol:.4f} and CIs do not overlap"
-};
-
-/// Throws std::invalid_argument "at least one episode is required" if either total is 0.
-ParityVerdict parity_verdict(std::int64_t reference_successes, std::int64_t reference_total,
-                             std::int64_t wrapped_successes, std::int64_t wrapped_total,
-                             double tolerance = kParityTolerance);
-
-/// Gate 0 for one (backbone, task).
-struct Gate0Verdict {
-  std::string backbone;
-  std::string task;
-  CompetenceVerdict competence;             ///< of the unwrapped runs
-  ParityVerdict identity_parity;            ///< unwrapped vs identity-wrapped
-  std::optional<ParityVerdict> oracle_parity;  ///< unwrapped vs oracle through a non-identity contract, if run
-  bool passed{false};                       ///< competence ∧ every parity
-  std::string decision;                     ///< "advance" or "exclude"
-  std::string reason;                       ///< first failing check ("competence: …", "identity parity: …"), or empty
-};
-
-/// Gate 0 over record sets (success_once is counted).
-/// Throws std::invalid_argument "at least one episode is required" for an empty set.
-Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view task,
-                           const std::vector<EpisodeRecord>& unwrapped, const std::vector<EpisodeRecord>& identity,
-                           const std::vector<EpisodeRecord>* oracle_nonidentity = nullptr,
-                           double floor = kDefaultCompetenceFloor, CompetenceRule rule = CompetenceRule::wilson_lower);
-
-/// Verdict file: {"schema_version","gate":"gate0","passed","cells":{"<backbone>/<task>":{...,"verdict"}}}.
-nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts);
+// Gate 0 (backbone competence and wrapper parity) is computed where its rollouts are: policy/gate0.hpp.
 
 // ---------------------------------------------------------------------------------------------
 // Gate 1: privileged ceiling (issue 5; reference §8.2)

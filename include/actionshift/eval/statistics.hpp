@@ -2,6 +2,8 @@
 /// \file Statistics for evaluation results: Wilson score intervals, percentile bootstrap, paired
 /// success differences and a two-proportion summary (reference §9, Appendix A.3).
 
+#include "actionshift/core/wilson.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <random>
@@ -9,34 +11,15 @@
 
 namespace actionshift::eval {
 
-/// z for a two-sided 95 % interval exactly as the reference computes it:
-/// Python's `statistics.NormalDist().inv_cdf(0.975)` = 1.9599639845400536.
-/// \note The issue writes z = 1.959963984540054 (the quantile to 16 digits); that literal parses to
-/// the double one ulp above this one, and with it 0/600 gives a lower bound of 4.3e-19 instead of
-/// the reference's 0.0 (Appendix A.3). The reference's double reproduces every A.3 value bit for bit.
-inline constexpr double kZ95 = 1.9599639845400536;
+using actionshift::kZ95;
 /// Default number of bootstrap resamples (DESIGN §8).
 inline constexpr std::size_t kBootstrapSamples = 10000;
 /// Default bootstrap seed (the reference's experimental seed, §7.6).
 inline constexpr std::uint64_t kBootstrapSeed = 20260718;
 
-/// A Wilson score interval for a binomial proportion.
-struct WilsonInterval {
-  std::int64_t successes{0};  ///< number of successes s
-  std::int64_t total{0};      ///< number of trials n (> 0)
-  double rate{0.0};           ///< s / n
-  double lower{0.0};          ///< centre − half-width (not clamped, as the reference)
-  double upper{0.0};          ///< centre + half-width (not clamped: 600/600 gives 1.0000000000000002)
-  double confidence{0.95};    ///< nominal coverage
-  bool operator==(const WilsonInterval&) const = default;
-};
-
-/// Wilson score interval with the reference's formula and no clamping:
-/// p = s/n, d = 1 + z²/n, centre = (p + z²/(2n))/d, half = z·sqrt(p(1−p)/n + z²/(4n²))/d.
-/// `z` defaults to kZ95; `confidence` is recorded only.
-/// Throws std::invalid_argument if total ≤ 0 ("at least one trial is required") or successes ∉ [0, total].
-WilsonInterval wilson_interval(std::int64_t successes, std::int64_t total, double z = kZ95,
-                               double confidence = 0.95);
+/// Wilson score interval (core/wilson.hpp).
+using actionshift::WilsonInterval;
+using actionshift::wilson_interval;
 
 /// A percentile bootstrap interval of a mean.
 struct BootstrapInterval {

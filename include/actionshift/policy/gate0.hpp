@@ -6,10 +6,11 @@
 /// |delta| <= 0.02 and the overlapping-Wilson rule reported separately; parity passes if either
 /// holds). Decision "advance" iff competence and parity pass, else "exclude".
 ///
-/// \note This mirrors eval/gates.hpp (same rules, reason strings and verdict-file layout: a verdict
-/// file is {"schema_version","gate":"gate0","passed","cells":{"<backbone>/<task>":{...,"verdict"}}})
-/// so `actionshift gate check` reads it; it lives here because the eval layer sits above policy.
+/// \note The verdict file is {"schema_version","gate":"gate0","passed","cells":{"<backbone>/<task>":
+/// {...,"verdict"}}}, the layout `actionshift gate check` reads.
+/// Gate 0 lives here, next to its rollouts; the Wilson interval is core's (core/wilson.hpp).
 
+#include "actionshift/core/wilson.hpp"
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/policy/rollout.hpp"
 
@@ -23,16 +24,13 @@
 
 namespace actionshift::policy {
 
-/// z of a two-sided 95 % interval as the reference computes it (NormalDist().inv_cdf(0.975)).
-inline constexpr double kGate0Z95 = 1.9599639845400536;
+/// z of a two-sided 95 % interval as the reference computes it (core/wilson.hpp).
+inline constexpr double kGate0Z95 = actionshift::kZ95;
 /// Two-point parity tolerance (2 percentage points).
 inline constexpr double kGate0ParityTolerance = 0.02;
 
-/// Wilson score interval (not clamped, as the reference).
-struct Wilson {
-  std::int64_t successes{0}, total{0};
-  double rate{0.0}, lower{0.0}, upper{0.0}, confidence{0.95};
-};
+/// Wilson score interval (not clamped, as the reference; core/wilson.hpp).
+using Wilson = actionshift::WilsonInterval;
 /// Throws std::invalid_argument "at least one episode is required" for total <= 0, and if
 /// successes is outside [0, total].
 Wilson wilson(std::int64_t successes, std::int64_t total);
