@@ -82,14 +82,26 @@ double posterior(const PoolBelief& b, const std::vector<int>& active, const std:
   return std::log(sum) - weighted / sum;  // −Σ p ln p with ln p = x − ln Σe
 }
 
+// the belief restricted to its active hypotheses (ProbeOptions::max_active / active_mass)
+struct ActiveBelief {
+  Eigen::VectorXd p;        // probabilities of every hypothesis
+  std::vector<int> active;  // indices, increasing
+  double mass{0};           // Σ p over `active`
+};
+
+ActiveBelief active_belief(const PoolBelief& b, const ProbeOptions& o) {
+  ActiveBelief a;
+  a.p = b.probs();
+  a.active = active_hypotheses(a.p, o.max_active, o.active_mass);
+  for (int h : a.active) a.mass += a.p[h];
+  return a;
+}
+
 }  // namespace
 
 std::vector<double> expected_posterior_entropy(const PoolBelief& b, const std::vector<Action>& candidates, const Mat3& R,
                                                const ProbeOptions& o) {
-  const Eigen::VectorXd p = b.probs();
-  const std::vector<int> active = active_hypotheses(p, o.max_active, o.active_mass);
-  double mass = 0;
-  for (int h : active) mass += p[h];
+  const auto [p, active, mass] = active_belief(b, o);
   std::vector<Action> preds;
   Eigen::VectorXd post;
   std::vector<double> out;
@@ -109,10 +121,7 @@ std::vector<double> expected_posterior_entropy(const PoolBelief& b, const std::v
 
 std::vector<double> expected_response_magnitude(const PoolBelief& b, const std::vector<Action>& candidates, const Mat3& R,
                                                 const ProbeOptions& o) {
-  const Eigen::VectorXd p = b.probs();
-  const std::vector<int> active = active_hypotheses(p, o.max_active, o.active_mass);
-  double mass = 0;
-  for (int h : active) mass += p[h];
+  const auto [p, active, mass] = active_belief(b, o);
   std::vector<Action> preds;
   std::vector<double> out;
   out.reserve(candidates.size());

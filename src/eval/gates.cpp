@@ -17,10 +17,6 @@ namespace {
 
 using nlohmann::json;
 
-json wilson_json(const WilsonInterval& w) {
-  return {{"successes", w.successes}, {"total", w.total}, {"rate", w.rate},
-          {"lower", w.lower},         {"upper", w.upper}, {"confidence", w.confidence}};
-}
 
 json bootstrap_json(const BootstrapInterval& b) {
   return {{"estimate", b.estimate}, {"lower", b.lower},     {"upper", b.upper}, {"confidence", b.confidence},

@@ -1,5 +1,7 @@
 #include "actionshift/eval/statistics.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,6 +9,12 @@
 #include <string>
 
 namespace actionshift::eval {
+
+nlohmann::json wilson_json(const WilsonInterval& w) {
+  return {{"successes", w.successes}, {"total", w.total}, {"rate", w.rate},
+          {"lower", w.lower},         {"upper", w.upper}, {"confidence", w.confidence}};
+}
+
 
 std::uint64_t BoundedRng::below(std::uint64_t n) {
   if (n == 0) throw std::invalid_argument("BoundedRng::below: n must be positive");

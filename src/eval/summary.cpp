@@ -15,10 +15,6 @@ namespace actionshift::eval {
 namespace {
 using nlohmann::json;
 
-json wilson_json(const WilsonInterval& w) {
-  return {{"successes", w.successes}, {"total", w.total}, {"rate", w.rate},
-          {"lower", w.lower},         {"upper", w.upper}, {"confidence", w.confidence}};
-}
 }  // namespace
 
 std::string fixed(double x, int digits) {

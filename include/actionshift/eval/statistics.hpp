@@ -4,6 +4,8 @@
 
 #include "actionshift/core/wilson.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <random>
@@ -20,6 +22,9 @@ inline constexpr std::uint64_t kBootstrapSeed = 20260718;
 /// Wilson score interval (core/wilson.hpp).
 using actionshift::WilsonInterval;
 using actionshift::wilson_interval;
+
+/// {"successes","total","rate","lower","upper","confidence"}: how every summary and verdict file writes an interval.
+nlohmann::json wilson_json(const WilsonInterval& w);
 
 /// A percentile bootstrap interval of a mean.
 struct BootstrapInterval {
