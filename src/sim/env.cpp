@@ -232,6 +232,17 @@ bool finite_snapshot(const TaskSnapshot& s) {
   return ok;
 }
 
+// end the episode with a safety flag: nothing more is simulated, no success, no reward
+const StepResult& end_episode(detail::EnvImpl& e, SafetyFlag f) {
+  e.last.safety = f;
+  e.last.success = false;
+  e.last.terminated = false;
+  e.last.reward = 0.0;
+  e.stats.safety = f;
+  e.stats.success_at_end = false;
+  return e.last;
+}
+
 }  // namespace
 
 const Eigen::VectorXd& Env::reset(std::uint64_t seed) {
@@ -356,15 +367,7 @@ const StepResult& Env::step(std::span<const double> a) {
   if (e.last.episode_over()) return e.last;
 
   // fail closed on the action before anything is simulated
-  auto end_with = [&](SafetyFlag f) -> const StepResult& {
-    e.last.safety = f;
-    e.last.success = false;
-    e.last.terminated = false;
-    e.last.reward = 0.0;
-    e.stats.safety = f;
-    e.stats.success_at_end = false;
-    return e.last;
-  };
+  auto end_with = [&](SafetyFlag f) -> const StepResult& { return end_episode(e, f); };
   if (a.size() != static_cast<std::size_t>(kActionDim)) return end_with(SafetyFlag::kBadActionShape);
   for (double v : a)
     if (!std::isfinite(v)) return end_with(SafetyFlag::kNonfiniteAction);
@@ -419,13 +422,7 @@ const StepResult& Env::abort(SafetyFlag flag) {
   detail::EnvImpl& e = *impl_;
   if (!e.started) throw std::logic_error("Env::abort called before reset");
   if (e.last.episode_over() || flag == SafetyFlag::kNone) return e.last;
-  e.last.safety = flag;
-  e.last.success = false;
-  e.last.terminated = false;
-  e.last.reward = 0.0;
-  e.stats.safety = flag;
-  e.stats.success_at_end = false;
-  return e.last;
+  return end_episode(e, flag);
 }
 
 }  // namespace actionshift::sim

@@ -103,7 +103,8 @@ ArticulationLayout::ArticulationLayout(const RobotDescription& desc) {
         inertia += in + m * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
       }
     } else {
-      // bullet needs mass on movable bodies: a tiny placeholder
+      // a massless movable link (e.g. a frame-only link): Bullet needs a positive mass, so it gets
+      // 1 g and a matching small inertia, negligible against the Panda's 0.015-4.97 kg links
       mass = 1e-3;
       inertia = 1e-7 * Eigen::Matrix3d::Identity();
     }
@@ -185,26 +186,23 @@ PhysicsWorld::PhysicsWorld(const RobotDescription& desc, const ArticulationLayou
   q_target_ = Eigen::VectorXd::Zero(num_dofs());
 }
 
-PhysicsWorld::~PhysicsWorld() {
-  // remove everything from the world before the pieces are destroyed
-  if (world_) {
+void PhysicsWorld::detach_all() {
+  if (!world_) return;
     for (auto& c : constraints_) world_->removeMultiBodyConstraint(c.get());
     for (auto& o : objects_) world_->removeRigidBody(o.get());
     if (table_) world_->removeRigidBody(table_.get());
     for (auto& c : colliders_) world_->removeCollisionObject(c.get());
     if (robot_) world_->removeMultiBody(robot_.get());
-  }
+}
+
+PhysicsWorld::~PhysicsWorld() {
+  // remove everything from the world before the pieces are destroyed
+  detach_all();
 }
 
 void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::VectorXd& qpos) {
   // tear down in dependency order
-  if (world_) {
-    for (auto& c : constraints_) world_->removeMultiBodyConstraint(c.get());
-    for (auto& o : objects_) world_->removeRigidBody(o.get());
-    if (table_) world_->removeRigidBody(table_.get());
-    for (auto& c : colliders_) world_->removeCollisionObject(c.get());
-    if (robot_) world_->removeMultiBody(robot_.get());
-  }
+  detach_all();
   constraints_.clear();
   motors_.clear();
   objects_.clear();

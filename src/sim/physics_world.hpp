@@ -95,6 +95,8 @@ class PhysicsWorld {
   const Eigen::Isometry3d& base_pose() const { return base_pose_; }
 
  private:
+  /// Remove every constraint, body and collider from the Bullet world (before destroying them).
+  void detach_all();
   void build_robot(const Eigen::VectorXd& qpos);
   void compute_contact_forces();
 
