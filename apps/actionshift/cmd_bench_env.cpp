@@ -15,11 +15,11 @@ int run_bench_env(const BenchEnvOptions& o) {
     std::fprintf(stderr, "actionshift: error: --steps: must be >= 1 (got %lld)\n", o.steps);
     return kBadInput;
   }
-  const sim::EnvThroughput one = sim::measure_env_throughput(task, o.steps, 1);
-  const sim::EnvThroughput all = sim::measure_env_throughput(task, o.steps, threads);
+  const sim::EnvThroughput one = sim::measure_env_throughput(task, o.steps, 1, 1, o.profile);
+  const sim::EnvThroughput all = sim::measure_env_throughput(task, o.steps, threads, 1, o.profile);
   if (o.json) {
-    std::printf("{\"task\":\"%s\",\"threads\":%d,\"steps_per_s_one_thread\":%.1f,\"steps_per_s_all_threads\":%.1f}\n",
-                std::string(sim::task_name(task)).c_str(), threads, one.steps_per_s, all.steps_per_s);
+    std::printf("{\"task\":\"%s\",\"profile\":\"%s\",\"threads\":%d,\"steps_per_s_one_thread\":%.1f,\"steps_per_s_all_threads\":%.1f}\n",
+                std::string(sim::task_name(task)).c_str(), o.profile.c_str(), threads, one.steps_per_s, all.steps_per_s);
   } else {
     std::printf("task %s: scripted grasp-and-lift episodes (contact), %lld control steps per thread\n",
                 std::string(sim::task_name(task)).c_str(), o.steps);

@@ -138,12 +138,21 @@ int run_gate_check(const GateCheckOptions& o, std::ostream& out, std::ostream& e
     if (!o.actual_file.empty()) {
       actual = read_json_file(o.actual_file);
     } else {
-      if (!expected.is_object() || expected.value("gate", "") != "gate1")
+      const std::string gate = expected.is_object() && expected.contains("gate") && expected["gate"].is_string()
+                                   ? expected["gate"].get<std::string>()
+                                   : std::string();
+      if (gate != "gate1" && gate != "promotion")
         throw InputError(o.expected_file, "gate",
-                         "only gate1 verdicts can be recomputed from --results; use --actual FILE for other gates");
+                         "only gate1 and promotion verdicts can be recomputed from --results; use --actual FILE for other gates");
       const eval::ResultSet rs = eval::load_results(o.results_dir);
       for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
-      actual = eval::gate1_to_json(eval::gate1(rs.records));
+      if (gate == "gate1") {
+        actual = eval::gate1_to_json(eval::gate1(rs.records));
+      } else {
+        for (const char* k : {"candidate", "baseline"})
+          if (!expected.contains(k) || !expected[k].is_string()) throw InputError(o.expected_file, k, "missing method name");
+        actual = eval::promotion_report(rs.records, expected["candidate"].get<std::string>(), expected["baseline"].get<std::string>());
+      }
     }
     const auto changes = eval::compare_verdicts(expected, actual, o.expected_file);
     std::size_t regressions = 0;

@@ -39,6 +39,8 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     policy::TrainBcOptions t;
     t.task = sim::parse_task(o.task);
     t.delay_aware = o.delay_aware;
+    (void)sim::profile_config(o.profile);  // validates the name
+    t.profile = o.profile;
     t.seed = o.seed;
     t.iterations = o.iterations;
     t.episodes_per_iteration = o.episodes;
@@ -50,7 +52,8 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     const std::string path = o.out.empty() ? policy::mlp_weights_path(backbone, t.task) : o.out;
     std::string command = "actionshift train bc --task " + o.task + (o.delay_aware ? " --delay-aware" : "") +
                           " --seed " + std::to_string(o.seed) + " --iterations " + std::to_string(o.iterations) +
-                          " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps);
+                          " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps) +
+                          " --profile " + o.profile;
     err << "train bc: " << o.task << " " << backbone << ", layers " << sim::observation_layout(t.task).size() +
                                                                             (o.delay_aware ? 28 : 0)
         << "-256-256-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
@@ -90,6 +93,8 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
     if (o.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
     run.episodes = o.episodes;
     run.seed = o.seed;
+    (void)sim::profile_config(o.profile);  // validates the name
+    run.profile = o.profile;
     run.floor = o.floor;
     run.rule = policy::parse_gate0_rule(o.rule);
     run.threads = o.threads;

@@ -12,6 +12,7 @@ namespace actionshift::cli {
 //  [--steps N] [--threads N] [--out FILE]`
 struct TrainBcOptions {
   std::string task;                 // --task
+  std::string profile{"maniskill"}; // --profile
   bool delay_aware{false};          // --delay-aware: history of 4 actions, random lag {0,1,2,4}
   std::uint64_t seed{20260718};     // --seed
   int iterations{8};                // --iterations (DAgger iterations, the first is the expert's)
@@ -27,6 +28,7 @@ int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, s
 struct Gate0Options {
   std::string backbone{"expert"};   // --backbone
   std::string task;                 // --task
+  std::string profile{"maniskill"}; // --profile
   std::int64_t episodes{300};       // --episodes
   std::uint64_t seed{20260718};     // --seed
   double floor{-1.0};               // --floor (< 0: the task's reference floor)

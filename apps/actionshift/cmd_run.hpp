@@ -26,9 +26,17 @@ int run_plan_cli(const PlanOptions& o);
 // `actionshift calibrate --task T [--episodes N] [--steps N] [--seed S] [--out FILE] [--json]`
 struct CalibrateOptions {
   std::string task;
-  int episodes{16};
-  int steps{50};
+  std::string profile{"maniskill"};
+  std::string protocol{"reference_walk"};
+  int episodes{8};
+  int steps{64};
   std::uint64_t seed{20260720};
+  // ablation overrides of the profile ("" = the profile's own setting); the calibration's profile
+  // label then names them, e.g. "maniskill[ik=converged]"
+  std::string ik;                    // single_step | converged
+  std::string drive;                 // implicit_pd | velocity_servo
+  int solver_iterations{0};          // > 0: Bullet solver iterations
+  std::string joint_limits;          // on | off: arm joint limit constraints
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table
 };

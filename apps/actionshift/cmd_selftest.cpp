@@ -75,8 +75,8 @@ std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
 
 adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
   if (!o.calibration.empty()) return adapt::ResponseCalibration::load(o.calibration);
-  if (auto text = data::builtin_calibration_text(o.task))
-    return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.task);
+  if (auto text = data::builtin_calibration_text(o.task, o.profile))
+    return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/" + o.task);
   throw InputError("", "--calibration",
                    "no built-in response calibration for task '" + o.task + "' in this build: pass --calibration FILE");
 }
@@ -94,7 +94,7 @@ selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::Observati
 // the episode ended early
 std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o) {
   const sim::TaskId task = sim::parse_task(o.task);
-  auto model = sim::EnvModel::make(task);
+  auto model = sim::EnvModel::make(task, sim::profile_config(o.profile));
   sim::HiddenContractEnv env(model, hidden,
                              o.frame_rotation == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp);
   st.begin(pose_from_obs(env.reset(o.seed), env.layout()));

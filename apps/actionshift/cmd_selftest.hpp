@@ -22,6 +22,7 @@ struct SelftestOptions {
   std::string hidden_contract;               ///< contract argument; default: the expected contract
   std::string expected = "identity";         ///< contract argument
   bool sim = false;                          ///< probe the Bullet environment instead of the synthetic stand-in
+  std::string profile = "maniskill";         ///< --sim: simulator fidelity profile
   std::string calibration;                   ///< --sim: calibration JSON file (default: the task's built-in one)
   std::string frame_rotation = "live";       ///< --sim: live | identity
   std::vector<std::string> pools;            ///< "library", a manifest name or file (repeatable; default below)

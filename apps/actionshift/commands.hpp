@@ -42,6 +42,7 @@ int run_splits_generate(const SplitsGenerateOptions& o);
 // ---- bench env (cmd_bench_env.cpp, sim layer)
 struct BenchEnvOptions {
   std::string task = "pick_cube";  ///< task name
+  std::string profile = "maniskill";  ///< simulator fidelity profile
   long long steps = 12000;         ///< control steps per thread (short runs are dominated by machine noise)
   int threads = 0;                 ///< 0: all hardware threads
   bool json = false;               ///< one JSON object: task, threads, steps_per_s_one_thread, steps_per_s_all_threads

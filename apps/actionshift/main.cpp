@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
              "on one thread and on all threads");
   bench_env->add_option("--task", bench_env_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")
       ->capture_default_str();
+  bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
   bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
   bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
       ->capture_default_str();
@@ -101,6 +102,8 @@ int main(int argc, char** argv) {
       ->excludes(st_demo);
   st->add_option("--expected", st_o.expected, "The wiring the policy assumes")->capture_default_str();
   st->add_flag("--sim", st_o.sim, "Probe the Bullet environment of --task instead of the synthetic stand-in");
+  st->add_option("--profile", st_o.profile, "--sim: simulator fidelity profile: maniskill or ideal (docs/sim.md)")
+      ->capture_default_str();
   st->add_option("--calibration", st_o.calibration, "--sim: response calibration JSON (default: the task's built-in one)");
   st->add_option("--frame-rotation", st_o.frame_rotation, "--sim: live (TCP orientation) or identity")->capture_default_str();
   st->add_option("--pool", st_o.pools,
@@ -124,6 +127,8 @@ int main(int argc, char** argv) {
       "bc", "Train the MLP backbone of a task by DAgger from the scripted expert (Eigen, Adam; seeded and\n"
             "deterministic). Writes configs/backbones/<task>.mlp[-delay-aware].asmlp (docs/backbones.md).");
   bc->add_option("--task", train_o.task, "pick_cube, push_cube, pull_cube, stack_cube")->required();
+  bc->add_option("--profile", train_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")
+      ->capture_default_str();
   bc->add_flag("--delay-aware", train_o.delay_aware, "Append the last 4 actions to the input; train under random lag {0,1,2,4}");
   bc->add_option("--seed", train_o.seed, "Seed")->capture_default_str();
   bc->add_option("--iterations", train_o.iterations, "DAgger iterations (the first rolls out the expert)")->capture_default_str();
@@ -139,6 +144,8 @@ int main(int argc, char** argv) {
                "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<file>, external:<command>.");
   gate0->add_option("--backbone", gate0_o.backbone, "Backbone")->capture_default_str();
   gate0->add_option("--task", gate0_o.task, "Task")->required();
+  gate0->add_option("--profile", gate0_o.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")
+      ->capture_default_str();
   gate0->add_option("--episodes", gate0_o.episodes, "Episodes (each run unwrapped and identity-wrapped)")->capture_default_str();
   gate0->add_option("--seed", gate0_o.seed, "Experimental seed")->capture_default_str();
   gate0->add_option("--floor", gate0_o.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)");
@@ -173,6 +180,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->add_option("--pool", run_o.request.pool, "Declared pool for pool-belief methods: reference9, full or a file");
   run->add_option("--rotation-mode", run_o.request.rotation_mode, "Tool-frame rotation: live (TCP) or identity")
+      ->capture_default_str();
+  run->add_option("--profile", run_o.request.profile,
+                  "Simulator fidelity profile: maniskill (one-step IK, PD drives with inertia, as ManiSkill) or\n"
+                  "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")
       ->capture_default_str();
   run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
   run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)");
@@ -252,10 +263,19 @@ int main(int argc, char** argv) {
       "calibrate", "Measure each pose channel's response gain, noise and R^2 on the unwrapped environment with\n"
                    "random actions (the likelihood of the belief adapters); prints the table, --out writes the JSON.");
   calibrate->add_option("--task", cal_o.task, "Task")->required();
-  calibrate->add_option("--episodes", cal_o.episodes, "Episodes of random actions")->capture_default_str();
-  calibrate->add_option("--steps", cal_o.steps, "Steps per episode (at most the horizon)")->capture_default_str();
+  calibrate->add_option("--profile", cal_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
+  calibrate->add_option("--protocol", cal_o.protocol,
+                        "reference_walk (the reference's: random walks without resets, 63 samples each) or\n"
+                        "episodes (task episodes with resets, capped at the horizon)")
+      ->capture_default_str();
+  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (reference_walk) or episodes")->capture_default_str();
+  calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode")->capture_default_str();
+  calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
+  calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");
+  calibrate->add_option("--solver-iterations", cal_o.solver_iterations, "Ablation: Bullet solver iterations");
+  calibrate->add_option("--joint-limits", cal_o.joint_limits, "Ablation: arm joint limit constraints on or off");
   calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
-  calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<task>.json)");
+  calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
   calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
 

@@ -14,7 +14,8 @@
 namespace actionshift::adapt {
 
 namespace {
-constexpr const char* kSchema = "actionshift-calibration/1";
+constexpr const char* kSchema = "actionshift-calibration/2";
+constexpr const char* kSchemaV1 = "actionshift-calibration/1";
 }
 
 LinearFit fit_linear_response(const std::vector<Pose6>& x, const std::vector<Pose6>& y) {
@@ -60,6 +61,8 @@ std::string ResponseCalibration::to_json() const {
   j["steps"] = steps;
   j["seed"] = seed;
   j["rotation_mode"] = rotation_mode;
+  j["profile"] = profile;
+  j["protocol"] = protocol;
   return canonical_dump(j);
 }
 
@@ -69,16 +72,20 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
   if (!j.is_object()) throw InputError(source, "", "calibration must be a JSON object");
+  if (!j.contains("schema_version")) throw InputError(source, "schema_version", "missing field");
+  const bool v1 = j["schema_version"] == kSchemaV1;
+  if (!v1 && j["schema_version"] != kSchema)
+    throw InputError(source, "schema_version", std::string("expected '") + kSchema + "' (or '" + kSchemaV1 + "')");
   static const char* kKeys[] = {"schema_version", "task", "position_start", "quaternion_start", "alpha", "sigma",
-                                "fit_r2", "episodes", "steps", "seed", "rotation_mode"};
+                                "fit_r2", "episodes", "steps", "seed", "rotation_mode", "profile", "protocol"};
+  const std::size_t nkeys = v1 ? 11 : 13;
   for (auto it = j.begin(); it != j.end(); ++it) {
     bool known = false;
-    for (const char* k : kKeys) known = known || it.key() == k;
+    for (std::size_t k = 0; k < nkeys; ++k) known = known || it.key() == kKeys[k];
     if (!known) throw InputError(source, it.key(), "unknown field");
   }
-  for (const char* k : kKeys)
-    if (!j.contains(k)) throw InputError(source, k, "missing field");
-  if (j["schema_version"] != kSchema) throw InputError(source, "schema_version", std::string("expected '") + kSchema + "'");
+  for (std::size_t k = 0; k < nkeys; ++k)
+    if (!j.contains(kKeys[k])) throw InputError(source, kKeys[k], "missing field");
   ResponseCalibration c;
   auto str = [&](const char* k) {
     if (!j[k].is_string()) throw InputError(source, k, "must be a string");
@@ -103,6 +110,10 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   };
   c.task = str("task");
   c.rotation_mode = str("rotation_mode");
+  c.profile = v1 ? "ideal" : str("profile");
+  c.protocol = v1 ? "episodes" : str("protocol");
+  if (c.protocol != "reference_walk" && c.protocol != "episodes")
+    throw InputError(source, "protocol", "must be 'reference_walk' or 'episodes'");
   c.slice.position_start = static_cast<int>(integer("position_start", 0));
   c.slice.quaternion_start = static_cast<int>(integer("quaternion_start", 0));
   c.episodes = static_cast<int>(integer("episodes", 1));

@@ -32,7 +32,7 @@ nlohmann::json defaults(const std::string& m) {
     p["motion_tiebreak"] = true;
   }
   if (m == "dualabi") {
-    p["tau"] = 2.5;  // frozen by the seed-20260718 pilot (docs/results/dualabi_pilot.md); the reference used 1.5
+    p["tau"] = 1.5;  // frozen by the pilot on seeds 20260723/24 (docs/results/dualabi_pilot.md); the reference also froze 1.5
     p["window"] = 8;
   }
   return p;

@@ -14,9 +14,12 @@ extern const std::pair<std::string_view, const std::string_view*> kBuiltinCalibr
 extern const int kBuiltinCalibrationCount;
 }  // namespace detail
 
-std::optional<std::string_view> builtin_calibration_text(std::string_view task) {
+std::optional<std::string_view> builtin_calibration_text(std::string_view task, std::string_view profile) {
+  std::string key(profile);
+  key += '/';
+  key += task;
   for (int i = 0; i < detail::kBuiltinCalibrationCount; ++i)
-    if (detail::kBuiltinCalibrations[i].first == task) return *detail::kBuiltinCalibrations[i].second;
+    if (detail::kBuiltinCalibrations[i].first == key) return *detail::kBuiltinCalibrations[i].second;
   return std::nullopt;
 }
 

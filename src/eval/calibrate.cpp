@@ -15,11 +15,33 @@ adapt::TcpSlice tcp_slice(const sim::ObservationLayout& layout) {
   return {f->offset, f->offset + 3};
 }
 
+std::string_view protocol_name(CalibrationProtocol p) {
+  return p == CalibrationProtocol::kReferenceWalk ? "reference_walk" : "episodes";
+}
+
+CalibrationProtocol parse_protocol(std::string_view name) {
+  if (name == "reference_walk") return CalibrationProtocol::kReferenceWalk;
+  if (name == "episodes") return CalibrationProtocol::kEpisodes;
+  throw std::invalid_argument("unknown calibration protocol '" + std::string(name) + "' (known: reference_walk, episodes)");
+}
+
 adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model, const CalibrationOptions& o) {
   if (o.episodes < 1) throw std::invalid_argument("calibration needs at least one episode");
   if (o.steps < 2) throw std::invalid_argument("calibration needs at least two steps per episode");
+  if (o.steps > 100000) throw std::invalid_argument("calibration steps must be at most 100000");
   const adapt::TcpSlice slice = tcp_slice(model->layout());
-  const int steps = std::min(o.steps, model->horizon());
+  const bool walk = o.protocol == CalibrationProtocol::kReferenceWalk;
+  int steps = std::min(o.steps, model->horizon());
+  if (walk) {
+    // the reference walks have no horizon and no workspace box: the same robot and profile, with
+    // the episode limit raised to the walk length and the workspace opened to the whole table
+    sim::EnvConfig cfg = model->config();
+    cfg.horizon = o.steps;
+    cfg.workspace.lower = Eigen::Vector3d(-10.0, -10.0, -10.0);
+    cfg.workspace.upper = Eigen::Vector3d(10.0, 10.0, 10.0);
+    model = sim::EnvModel::make(model->task(), cfg, model->robot_ptr());
+    steps = o.steps;
+  }
   sim::Env env(model);
   std::vector<Pose6> commanded, observed;
   for (int e = 0; e < o.episodes; ++e) {
@@ -30,8 +52,10 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
       for (int c = 0; c < kActionDim; ++c) a[c] = rng.uniform(-1.0, 1.0);
       const sim::StepResult& r = env.step(a);
       if (r.safety != sim::SafetyFlag::kNone) break;
-      commanded.push_back(a.head<kPoseDim>());
-      observed.push_back(adapt::tcp_response(prev, r.obs, slice));
+      if (!walk || t > 0) {  // the reference records states after each step: no sample for step 0
+        commanded.push_back(a.head<kPoseDim>());
+        observed.push_back(adapt::tcp_response(prev, r.obs, slice));
+      }
       prev = r.obs;
       if (r.episode_over()) break;
     }
@@ -44,6 +68,8 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
   c.steps = steps;
   c.seed = o.seed;
   c.rotation_mode = "live";
+  c.profile = model->config().profile;
+  c.protocol = std::string(protocol_name(o.protocol));
   return c;
 }
 

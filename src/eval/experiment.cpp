@@ -35,10 +35,13 @@ nlohmann::json parse_params(const std::string& text, const std::string& method) 
 
 }  // namespace
 
-adapt::ResponseCalibration builtin_calibration(const std::string& task) {
-  const auto text = data::builtin_calibration_text(task);
-  if (!text) throw InputError("calibration", task, "no built-in calibration for this task (run `actionshift calibrate --task " + task + "`)");
-  return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + task);
+adapt::ResponseCalibration builtin_calibration(const std::string& task, const std::string& profile) {
+  const auto text = data::builtin_calibration_text(task, profile);
+  if (!text)
+    throw InputError("calibration", task,
+                     "no built-in calibration for this task on profile '" + profile + "' (run `actionshift calibrate --task " + task +
+                         " --profile " + profile + "`)");
+  return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + profile + "/" + task);
 }
 
 std::string resolved_method_params(const std::string& method, const std::string& params_json) {
@@ -59,9 +62,9 @@ PlanResolver default_resolver() {
     const auto p = policy::make_policy(name, sim::parse_task(task));
     return BackboneRef{p->name(), p->sha256()};
   };
-  r.calibration = [](const std::string& task, const MethodEntry& m) -> std::optional<std::string> {
+  r.calibration = [](const std::string& task, const MethodEntry& m, const std::string& profile) -> std::optional<std::string> {
     if (!adapt::method_needs_calibration(m.name)) return std::nullopt;
-    return builtin_calibration(task).sha256();
+    return builtin_calibration(task, profile).sha256();
   };
   r.check_method = [](const MethodEntry& m) { adapt::resolve_method_params(m.name, parse_params(m.params, m.name)); };
   r.method_params = [](const MethodEntry& m) { return resolved_method_params(m.name, m.params); };
@@ -152,7 +155,7 @@ EpisodeFn make_episode_fn(const JobSpec& job) {
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
   const sim::TaskId task = sim::parse_task(job.task);
-  ctx->model = sim::EnvModel::make(task);
+  ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile));
   ctx->slice = tcp_slice(ctx->model->layout());
   ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
 
@@ -172,9 +175,10 @@ EpisodeFn make_episode_fn(const JobSpec& job) {
     throw InputError("job", "pool", "method '" + job.method + "' needs a pool (--pool reference9|full|FILE)");
   }
   if (adapt::method_needs_calibration(job.method)) {
-    const auto cal = builtin_calibration(job.task);
+    const auto cal = builtin_calibration(job.task, job.profile);
     if (!job.calibration_sha256 || *job.calibration_sha256 != cal.sha256())
-      throw InputError("job", "calibration_sha256", "does not match the built-in calibration of " + job.task + " (" + cal.sha256() + ")");
+      throw InputError("job", "calibration_sha256",
+                       "does not match the built-in calibration of " + job.task + " on profile " + job.profile + " (" + cal.sha256() + ")");
     if (cal.slice.position_start != ctx->slice.position_start || cal.slice.quaternion_start != ctx->slice.quaternion_start)
       throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
     ctx->response = cal.model();

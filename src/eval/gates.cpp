@@ -6,6 +6,7 @@
 #include <iomanip>
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <map>
 #include <set>
@@ -249,8 +250,10 @@ PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate, 
   const BootstrapInterval flag_diff = paired_success_difference(cf, bf, 0.95, samples, seed);
   v.safety_regression = v.candidate_flag_rate - v.baseline_flag_rate > kSafetyRegressionTolerance || flag_diff.lower > 0.0;
   v.five_point_rule = v.difference.estimate >= kPromotionMinGain - 1e-12 && v.difference.lower > 0.0;
-  // a Pareto point on (success, probe cost): strictly cheaper, and not less successful
-  v.pareto_rule = v.candidate_probe_steps < v.baseline_probe_steps && v.difference.estimate >= 0.0;
+  // a Pareto point on (success, probe cost): strictly cheaper, not less successful, and successful
+  // enough that the tie means something (0.000 vs 0.000 on an unsolved split promotes nothing)
+  v.pareto_rule = v.candidate_probe_steps < v.baseline_probe_steps && v.difference.estimate >= 0.0 &&
+                  v.candidate_rate >= kParetoSuccessFloor;
   const std::string diff = fixed(v.difference.estimate, 4) + " [" + fixed(v.difference.lower, 4) + ", " +
                            fixed(v.difference.upper, 4) + "]";
   if (v.matched_seeds == 1 && v.candidate_rate < kPruneSuccessFloor) {
@@ -272,13 +275,31 @@ PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate, 
                                        fixed(v.baseline_probe_steps, 2) + ", difference " + diff;
   } else {
     v.decision = "reject";
-    v.reason = "difference " + diff + " below " + fixed(kPromotionMinGain, 4) + " and no Pareto improvement in probe steps (" +
-               fixed(v.candidate_probe_steps, 2) + " vs " + fixed(v.baseline_probe_steps, 2) + ")";
+    const bool cheaper_tie = v.candidate_probe_steps < v.baseline_probe_steps && v.difference.estimate >= 0.0;
+    v.reason = "difference " + diff + " below " + fixed(kPromotionMinGain, 4) +
+               (cheaper_tie ? " and success " + fixed(v.candidate_rate, 4) + " below the Pareto floor " + fixed(kParetoSuccessFloor, 4)
+                            : " and no Pareto improvement in probe steps (" + fixed(v.candidate_probe_steps, 2) + " vs " +
+                                  fixed(v.baseline_probe_steps, 2) + ")");
   }
   return v;
 }
 
 // ---- verdict files
+
+namespace {
+// episodes a verdict cell rests on: its "episodes" field, else the smallest "total" of the Wilson
+// intervals it holds (gate 1: oracle and no_adapt); nullopt when the cell states neither
+std::optional<std::int64_t> cell_episodes(const json& cell) {
+  if (cell.contains("episodes") && cell["episodes"].is_number_integer()) return cell["episodes"].get<std::int64_t>();
+  std::optional<std::int64_t> n;
+  for (const char* k : {"oracle", "no_adapt", "competence"}) {
+    if (!cell.contains(k) || !cell[k].is_object() || !cell[k].contains("total") || !cell[k]["total"].is_number_integer()) continue;
+    const auto t = cell[k]["total"].get<std::int64_t>();
+    n = n ? std::min(*n, t) : t;
+  }
+  return n;
+}
+}  // namespace
 
 std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, const nlohmann::json& actual,
                                             const std::string& source) {
@@ -306,9 +327,17 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
     // a positive verdict (gate1 "pass", gate0 "advance", promotion "promote") that is lost regresses
     const bool positive = c.expected == "pass" || c.expected == "advance" || c.expected == "promote";
     c.regression = positive && c.actual != c.expected;
-    const std::string reason = present && ac[c.cell].contains("reason") && ac[c.cell]["reason"].is_string()
-                                   ? ac[c.cell]["reason"].get<std::string>()
-                                   : std::string();
+    std::string reason = present && ac[c.cell].contains("reason") && ac[c.cell]["reason"].is_string()
+                             ? ac[c.cell]["reason"].get<std::string>()
+                             : std::string();
+    // a verdict recomputed from fewer episodes than the expectation it is compared with proves nothing
+    const auto want = cell_episodes(it.value());
+    const auto have = present ? cell_episodes(ac[c.cell]) : std::nullopt;
+    if (want && have && *have < *want) {
+      c.regression = true;
+      reason = "rests on " + std::to_string(*have) + " episodes, fewer than the expected verdict's " + std::to_string(*want) +
+               (reason.empty() ? "" : "; " + reason);
+    }
     const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (c.actual == "pass" || c.actual == "advance" || c.actual == "promote" ? "improved" : "changed");
     c.line = std::string(tag) + " " + c.cell + ": expected " + c.expected + ", got " + c.actual +
              (reason.empty() ? "" : " (" + reason + ")");
@@ -343,10 +372,11 @@ json promotion_report(const std::vector<EpisodeRecord>& records, const std::stri
             {"rules",
              {{"min_gain", kPromotionMinGain},
               {"prune_below_one_seed", kPruneSuccessFloor},
+              {"pareto_success_floor", kParetoSuccessFloor},
               {"safety_regression_tolerance", kSafetyRegressionTolerance},
               {"order", "prune (one seed < 0.3), reject on a safety regression, extend_seeds (< 3 matched seeds), "
                         "promote on >= 5 points with the paired 95 % interval above 0 or on a Pareto point "
-                        "(fewer mean probe steps, paired success estimate >= 0), else reject"}}},
+                        "(fewer mean probe steps, paired success estimate >= 0, candidate success >= 0.3), else reject"}}},
             {"bootstrap", {{"samples", samples}, {"seed", seed}}},
             {"cells", json::object()}};
   for (const auto& [key, pair] : cells) {
@@ -358,6 +388,7 @@ json promotion_report(const std::vector<EpisodeRecord>& records, const std::stri
                        {"verdict", v.decision},
                        {"reason", v.reason},
                        {"matched_seeds", v.matched_seeds},
+                       {"episodes", static_cast<std::int64_t>(std::min(pair.first.size(), pair.second.size()))},
                        {"candidate_success", v.candidate_rate},
                        {"baseline_success", v.baseline_rate},
                        {"difference", bootstrap_json(v.difference)},

@@ -81,6 +81,9 @@ void validate_job(const JobSpec& job, const std::string& src) {
   bool mode_ok = false;
   for (auto m : kRotationModes) mode_ok = mode_ok || job.rotation_mode == m;
   if (!mode_ok) throw InputError(src, "rotation_mode", "expected \"live\" or \"identity\" (got \"" + job.rotation_mode + "\")");
+  bool profile_ok = false;
+  for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
+  if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got \"" + job.profile + "\")");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
 }
 
@@ -95,6 +98,7 @@ nlohmann::json job_to_json(const JobSpec& job) {
   j["pool"] = job.pool ? json{{"name", job.pool->name}, {"sha256", job.pool->sha256}} : json(nullptr);
   j["calibration_sha256"] = job.calibration_sha256 ? json(*job.calibration_sha256) : json(nullptr);
   j["rotation_mode"] = job.rotation_mode;
+  j["profile"] = job.profile;
   j["seed"] = job.seed;
   j["episodes"] = job.episodes;
   return j;
@@ -105,7 +109,7 @@ std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_t
 std::string job_id(const JobSpec& job) { return sha256_hex(job_canonical_json(job)); }
 
 JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
-  check_keys(j, {"backbone", "calibration_sha256", "episodes", "method", "pool", "rotation_mode", "schema_version",
+  check_keys(j, {"backbone", "calibration_sha256", "episodes", "method", "pool", "profile", "rotation_mode", "schema_version",
                  "seed", "split", "task"},
              src, "");
   if (j.at("schema_version") != std::string(kJobSchemaVersion))
@@ -137,6 +141,7 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
   const json& cal = j.at("calibration_sha256");
   if (!cal.is_null()) job.calibration_sha256 = str_at(j, "calibration_sha256", src, "calibration_sha256");
   job.rotation_mode = str_at(j, "rotation_mode", src, "rotation_mode");
+  job.profile = str_at(j, "profile", src, "profile");
   const auto seed = nonneg_int(j.at("seed"));
   if (!seed) throw InputError(src, "seed", "expected a non-negative integer");
   job.seed = *seed;

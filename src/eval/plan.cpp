@@ -130,13 +130,13 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   }
   if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
   static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
-                                               "seeds",    "episodes",    "backbone", "pool",   "rotation_mode"};
+                                               "seeds",    "episodes",    "backbone", "pool",   "rotation_mode", "profile"};
   for (const auto& kv : root) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
     if (!known.count(key))
       throw InputError(at_line(source, kv.first), key,
                        "unknown key (expected one of name, description, tasks, splits, methods, seeds, episodes, "
-                       "backbone, pool, rotation_mode)");
+                       "backbone, pool, rotation_mode, profile)");
   }
   for (const char* key : {"name", "tasks", "splits", "methods", "seeds", "episodes", "backbone"})
     if (!root[key]) throw InputError(source, key, "missing required key");
@@ -216,6 +216,13 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
       throw InputError(at_line(source, root["rotation_mode"]), "rotation_mode",
                        "expected \"live\" or \"identity\" (got \"" + ex.rotation_mode + "\")");
   }
+  if (root["profile"]) {
+    ex.profile = require_string(root["profile"], source, "profile");
+    bool ok = false;
+    for (auto p : kProfiles) ok = ok || ex.profile == p;
+    if (!ok)
+      throw InputError(at_line(source, root["profile"]), "profile", "expected \"maniskill\" or \"ideal\" (got \"" + ex.profile + "\")");
+  }
   return ex;
 }
 
@@ -232,8 +239,9 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.method_params = resolver.method_params ? resolver.method_params(q.method) : q.method.params;
   job.backbone = resolver.backbone(q.task, q.backbone);
   if (q.pool && (!resolver.method_uses_pool || resolver.method_uses_pool(q.method))) job.pool = resolver.pool(*q.pool);
-  job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, q.method) : std::nullopt;
+  job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, q.method, q.profile) : std::nullopt;
   job.rotation_mode = q.rotation_mode;
+  job.profile = q.profile;
   job.seed = q.seed;
   job.episodes = q.episodes;
   validate_job(job, "command line");
@@ -263,7 +271,7 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
       const SplitRef split = resolver.split(task, split_name);
       for (const auto& method : ex.methods) {
         const std::optional<std::string> calibration =
-            resolver.calibration ? resolver.calibration(task, method) : std::nullopt;
+            resolver.calibration ? resolver.calibration(task, method, ex.profile) : std::nullopt;
         for (const auto seed : ex.seeds) {
           PlannedJob pj;
           pj.index = static_cast<std::int64_t>(plan.jobs.size());
@@ -275,6 +283,7 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
           if (!resolver.method_uses_pool || resolver.method_uses_pool(method)) pj.spec.pool = pools[split_name];
           pj.spec.calibration_sha256 = calibration;
           pj.spec.rotation_mode = ex.rotation_mode;
+          pj.spec.profile = ex.profile;
           pj.spec.seed = seed;
           pj.spec.episodes = ex.episodes;
           validate_job(pj.spec, ex.source);

@@ -19,7 +19,7 @@ using nlohmann::json;
 const std::set<std::string>& record_keys() {
   static const std::set<std::string> keys = {
       "backbone",       "backbone_sha256", "contract_index",     "contract_sha256", "episode_index",
-      "job_id",         "method",          "probe_displacement", "probe_steps",     "return",
+      "job_id",         "method",          "probe_displacement", "probe_steps",     "profile",    "return",
       "safety_flags",   "schema_version",  "seed",               "split",           "steps",
       "success_at_end", "success_once",    "task"};
   return keys;
@@ -122,6 +122,7 @@ nlohmann::json to_json(const EpisodeRecord& r) {
   j["safety_flags"] = r.safety_flags;
   j["backbone"] = r.backbone;
   j["backbone_sha256"] = r.backbone_sha256;
+  j["profile"] = r.profile;
   return j;
 }
 
@@ -158,6 +159,7 @@ EpisodeRecord record_from_json(const nlohmann::json& j, const std::string& src) 
   }
   r.backbone = get_string(j, "backbone", src);
   r.backbone_sha256 = get_string(j, "backbone_sha256", src);
+  r.profile = get_string(j, "profile", src);
   validate_record(r, src);
   return r;
 }

@@ -149,6 +149,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
         r.episode_index = i;
         r.backbone = job.backbone.name;
         r.backbone_sha256 = job.backbone.sha256;
+        r.profile = job.profile;
         validate_record(r, "episode " + std::to_string(i));
         std::lock_guard lock(mu);
         ready.emplace(i, std::move(r));

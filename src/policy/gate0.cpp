@@ -101,7 +101,7 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
 
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   if (run.episodes <= 0) throw std::invalid_argument("at least one episode is required");
-  auto model = sim::EnvModel::make(policy.task());
+  auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile));
   RolloutOptions o;
   o.seed = run.seed;
   o.contract_index = 0;
@@ -115,6 +115,7 @@ Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   const double floor = run.floor < 0 ? gate0_floor(policy.task()) : run.floor;
   Gate0Verdict v = gate0_verdict(policy.name(), policy.sha256(), policy.task(), unwrapped, identity, floor, run.rule);
   v.seed = run.seed;
+  v.profile = run.profile;
   return v;
 }
 
@@ -134,6 +135,7 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
         {"backbone_sha256", v.backbone_sha256},
         {"task", v.task},
         {"seed", v.seed},
+        {"profile", v.profile},
         {"episodes", v.episodes},
         {"verdict", v.passed ? "pass" : "fail"},
         {"decision", v.decision},

@@ -125,7 +125,7 @@ TrainBcResult train_bc(const TrainBcOptions& o, const std::function<void(const T
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const int history = o.delay_aware ? kHistoryLength : 0;
-  auto model = sim::EnvModel::make(o.task);
+  auto model = sim::EnvModel::make(o.task, sim::profile_config(o.profile));
   MlpWeights net = MlpWeights::init(o.task, history, o.hidden, derive_seed({o.seed, kTrainStream, 0xffff}));
   const int in_dim = net.input_dim();
   Eigen::VectorXf out_weight = Eigen::VectorXf::Ones(kActionDim);

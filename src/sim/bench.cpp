@@ -30,10 +30,11 @@ long long run_episodes(const std::shared_ptr<const EnvModel>& model, long long s
 
 }  // namespace
 
-EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, int threads, std::uint64_t seed) {
+EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, int threads, std::uint64_t seed,
+                                     std::string_view profile) {
   if (threads < 1) throw std::invalid_argument("threads must be >= 1 (got " + std::to_string(threads) + ")");
   if (steps_per_thread < 1) throw std::invalid_argument("steps must be >= 1 (got " + std::to_string(steps_per_thread) + ")");
-  const auto model = EnvModel::make(task);
+  const auto model = EnvModel::make(task, profile_config(profile));
   std::vector<long long> done(static_cast<std::size_t>(threads), 0);
   const auto t0 = std::chrono::steady_clock::now();
   if (threads == 1) {

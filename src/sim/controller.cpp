@@ -80,4 +80,24 @@ IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::Vec
   return best;
 }
 
+IkResult single_step_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                        const PoseCommand& cmd, const IkOptions& options) {
+  Eigen::Isometry3d tip;
+  ChainJacobian jac;
+  chain.fk_jacobian(q0, tip, jac);
+  Eigen::Matrix<double, 6, 1> dx;
+  dx.head<3>() = cmd.delta_position;
+  dx.tail<3>() = cmd.delta_rotvec;
+  using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChainDof, kMaxChainDof>;
+  Square a = jac.transpose() * jac;
+  a.diagonal().array() += options.damping;
+  const ChainVector rhs = jac.transpose() * dx;
+  IkResult out;
+  out.q = q0 + a.ldlt().solve(rhs);
+  out.iterations = 1;
+  // residual of the linearised step (what the step leaves undone to first order)
+  out.error = (dx - jac * (out.q - q0)).norm();
+  return out;
+}
+
 }  // namespace actionshift::sim

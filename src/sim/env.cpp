@@ -76,6 +76,23 @@ std::string_view safety_flag_name(SafetyFlag f) {
   return "unknown";
 }
 
+// ---- profiles
+
+std::vector<std::string> profile_names() { return {"maniskill", "ideal"}; }
+
+EnvConfig profile_config(std::string_view name) {
+  EnvConfig c;
+  c.profile = std::string(name);
+  if (name == "maniskill") return c;  // the defaults
+  if (name == "ideal") {
+    c.ik.mode = IkMode::kConverged;
+    c.physics.arm_drive = ArmDrive::kVelocityServo;
+    c.physics.arm_joint_limits = false;  // the converged ik keeps its targets inside the limits
+    return c;
+  }
+  throw std::invalid_argument("unknown fidelity profile '" + std::string(name) + "' (known: maniskill, ideal)");
+}
+
 // ---- model
 
 EnvModel::~EnvModel() = default;
@@ -384,7 +401,8 @@ const StepResult& Env::step(std::span<const double> a) {
   ChainVector q_arm(7);
   for (int i = 0; i < 7; ++i) q_arm(i) = qb(e.data->arm_bodies[static_cast<std::size_t>(i)]);
   const Eigen::Isometry3d tcp = m.arm().fk(q_arm);
-  const IkResult ik = solve_ik(m.arm(), q_arm, target_pose(tcp, cmd), m.config().ik);
+  const IkResult ik = m.config().ik.mode == IkMode::kSingleStep ? single_step_ik(m.arm(), q_arm, cmd, m.config().ik)
+                                                                  : solve_ik(m.arm(), q_arm, target_pose(tcp, cmd), m.config().ik);
   for (int i = 0; i < 7; ++i) e.targets(e.data->arm_bodies[static_cast<std::size_t>(i)]) = ik.q(i);
   e.targets(e.data->finger_bodies[0]) = finger_target(g);
   e.targets(e.data->finger_bodies[1]) = finger_target(g);

@@ -44,6 +44,9 @@ constexpr int kGroupStatic = btBroadphaseProxy::StaticFilter;
 constexpr int kGroupDefault = btBroadphaseProxy::DefaultFilter;
 constexpr int kMaskAll = btBroadphaseProxy::AllFilter;
 
+// largest number of driven (non-finger) joints the implicit drive's fixed-capacity solve handles
+constexpr int kMaxArmDofs = 16;
+
 }  // namespace
 
 // ---- articulation layout
@@ -184,6 +187,13 @@ PhysicsWorld::PhysicsWorld(const RobotDescription& desc, const ArticulationLayou
   for (const auto& b : layout_.bodies) body_shapes_.push_back(build_compound(b));
   table_shape_ = std::make_unique<btBoxShape>(btVector3(kTableHalfX, kTableHalfY, kTableHalfZ));
   q_target_ = Eigen::VectorXd::Zero(num_dofs());
+  for (int i = 0; i < num_dofs(); ++i)
+    if (!is_finger(i)) arm_dofs_.push_back(i);
+  if (static_cast<int>(arm_dofs_.size()) > kMaxArmDofs)
+    throw std::invalid_argument("robot '" + desc.name + "': " + std::to_string(arm_dofs_.size()) + " driven joints, at most " +
+                                std::to_string(kMaxArmDofs) + " supported");
+  mass_ = Eigen::MatrixXd::Zero(num_dofs(), num_dofs());
+  jac_scratch_ = Eigen::MatrixXd::Zero(6, num_dofs());
 }
 
 void PhysicsWorld::detach_all() {
@@ -343,14 +353,18 @@ void PhysicsWorld::build_robot(const Eigen::VectorXd& qpos) {
   // drives, limits and mimic coupling
   for (int i = 0; i < n; ++i) {
     const auto& b = layout_.bodies[static_cast<std::size_t>(i)];
-    const bool finger = std::find(finger_bodies_.begin(), finger_bodies_.end(), i) != finger_bodies_.end();
+    const bool finger = is_finger(i);
     const double limit = finger ? cfg_.finger_force_limit : cfg_.arm_force_limit;
-    auto motor = std::make_unique<btMultiBodyJointMotor>(robot_.get(), i, 0, 0.0, limit * h_);
-    motor->setPositionTarget(0.0, 0.0);
-    motor->setVelocityTarget(0.0, 1.0);
-    motors_.push_back(motor.get());
-    world_->addMultiBodyConstraint(motor.get());
-    constraints_.push_back(std::move(motor));
+    if (finger || cfg_.arm_drive == ArmDrive::kVelocityServo) {
+      auto motor = std::make_unique<btMultiBodyJointMotor>(robot_.get(), i, 0, 0.0, limit * h_);
+      motor->setPositionTarget(0.0, 0.0);
+      motor->setVelocityTarget(0.0, 1.0);
+      motors_.push_back(motor.get());
+      world_->addMultiBodyConstraint(motor.get());
+      constraints_.push_back(std::move(motor));
+    } else {
+      motors_.push_back(nullptr);  // driven by apply_implicit_pd
+    }
     const auto& jd = desc_.joints[static_cast<std::size_t>(b.joint)];
     if ((finger || cfg_.arm_joint_limits) && std::isfinite(jd.lower) && std::isfinite(jd.upper)) {
       auto lim = std::make_unique<btMultiBodyJointLimitConstraint>(robot_.get(), i, jd.lower, jd.upper);
@@ -391,16 +405,17 @@ void PhysicsWorld::step_control() {
   const btVector3 g = world_->getGravity();
   const int steps = cfg_.sim_steps_per_control * cfg_.substeps_per_sim_step;
   for (int s = 0; s < steps; ++s) {
+    if (cfg_.arm_drive == ArmDrive::kImplicitPd) apply_implicit_pd();
     for (int i = 0; i < n; ++i) {
       const double q = robot_->getJointPos(i);
       const double err = q_target_(i) - q;
+      btMultiBodyJointMotor* motor = motors_[static_cast<std::size_t>(i)];
       // overdamped pd (K, D) reduced to its dominant first-order mode: v* = (K/D)(q* - q)
-      motors_[static_cast<std::size_t>(i)]->setVelocityTarget(k_over_d * err, 1.0);
-      const bool finger = std::find(finger_bodies_.begin(), finger_bodies_.end(), i) != finger_bodies_.end();
-      if (finger) {
+      if (motor != nullptr) motor->setVelocityTarget(k_over_d * err, 1.0);
+      if (is_finger(i)) {
         // a blocked pd drive pushes with K*|q*-q|: cap the motor at that (and at the force limit)
         const double f = std::min(cfg_.finger_force_limit, cfg_.drive_stiffness * std::abs(err));
-        motors_[static_cast<std::size_t>(i)]->setMaxAppliedImpulse(f * h_);
+        motor->setMaxAppliedImpulse(f * h_);
       }
       // exact gravity compensation: cancels the m*g the world applies to every link
       if (cfg_.gravity_compensation) robot_->addLinkForce(i, -g * robot_->getLinkMass(i));
@@ -408,6 +423,71 @@ void PhysicsWorld::step_control() {
     world_->stepSimulation(h_, 0, h_);
   }
   compute_contact_forces();
+}
+
+bool PhysicsWorld::is_finger(int body) const {
+  return std::find(finger_bodies_.begin(), finger_bodies_.end(), body) != finger_bodies_.end();
+}
+
+void PhysicsWorld::compute_mass_matrix() {
+  // M = sum over bodies of m Jv^T Jv + Jw^T (R I R^T) Jw, with the geometric jacobians of each body's
+  // centre of mass built from bullet's own kinematics of the current state (world frame)
+  const int n = num_dofs();
+  mass_.setZero();
+  for (int i = 0; i < n; ++i) {
+    const btMultibodyLink& link = robot_->getLink(i);
+    const Eigen::Vector3d com = eig(robot_->localPosToWorld(i, btVector3(0, 0, 0)));
+    const btMatrix3x3 basis = robot_->localFrameToWorld(i, btMatrix3x3::getIdentity());
+    Eigen::Matrix3d r;
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) r(a, c) = basis[a][c];
+    const Eigen::Vector3d inertia_local = eig(link.m_inertiaLocal);
+    jac_scratch_.setZero();
+    for (int j = i; j >= 0; j = robot_->getLink(j).m_parent) {
+      const btMultibodyLink& lj = robot_->getLink(j);
+      if (lj.m_jointType == btMultibodyLink::eRevolute) {
+        const Eigen::Vector3d axis = eig(robot_->localDirToWorld(j, lj.getAxisTop(0)));
+        const Eigen::Vector3d pivot = eig(robot_->localPosToWorld(j, -lj.m_dVector));
+        jac_scratch_.block<3, 1>(0, j) = axis.cross(com - pivot);
+        jac_scratch_.block<3, 1>(3, j) = axis;
+      } else if (lj.m_jointType == btMultibodyLink::ePrismatic) {
+        jac_scratch_.block<3, 1>(0, j) = eig(robot_->localDirToWorld(j, lj.getAxisBottom(0)));
+      }
+    }
+    const Eigen::Matrix3d inertia_world = r * inertia_local.asDiagonal() * r.transpose();
+    const auto jv = jac_scratch_.topRows<3>();
+    const auto jw = jac_scratch_.bottomRows<3>();
+    mass_.noalias() += link.m_mass * jv.transpose() * jv;
+    mass_.noalias() += jw.transpose() * inertia_world * jw;
+  }
+}
+
+void PhysicsWorld::apply_implicit_pd() {
+  // PhysX-style implicit PD drive on the arm joints. With tau = K (q* - q - h v') - D v' and
+  // v' = v + h M^-1 tau over one step h, the end-of-step velocity solves
+  //   (M + h (h K + D) I) v' = M v + h K (q* - q)
+  // (the arm block of the joint-space inertia M; gravity is compensated, Coriolis terms are left to
+  // bullet). The resulting torque is clipped to the drive's force limit and applied for the step, so
+  // the link inertia carries motion from one control step into the next as it does in ManiSkill.
+  compute_mass_matrix();
+  const int na = static_cast<int>(arm_dofs_.size());
+  if (na == 0) return;
+  const double k = cfg_.drive_stiffness, d = cfg_.drive_damping;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxArmDofs, kMaxArmDofs> a(na, na);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxArmDofs, 1> v(na), err(na);
+  for (int r = 0; r < na; ++r) {
+    const int br = arm_dofs_[static_cast<std::size_t>(r)];
+    v(r) = robot_->getJointVel(br);
+    err(r) = q_target_(br) - robot_->getJointPos(br);
+    for (int c = 0; c < na; ++c) a(r, c) = mass_(br, arm_dofs_[static_cast<std::size_t>(c)]);
+  }
+  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxArmDofs, 1> rhs = a * v + h_ * k * err;
+  a.diagonal().array() += h_ * (h_ * k + d);
+  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxArmDofs, 1> v_next = a.ldlt().solve(rhs);
+  for (int r = 0; r < na; ++r) {
+    const double tau = std::clamp(k * err(r) - (h_ * k + d) * v_next(r), -cfg_.arm_force_limit, cfg_.arm_force_limit);
+    robot_->addJointTorque(arm_dofs_[static_cast<std::size_t>(r)], tau);
+  }
 }
 
 void PhysicsWorld::compute_contact_forces() {

@@ -99,6 +99,11 @@ class PhysicsWorld {
   void detach_all();
   void build_robot(const Eigen::VectorXd& qpos);
   void compute_contact_forces();
+  /// Joint-space inertia matrix of the multibody at its current state (num_dofs square) into mass_.
+  void compute_mass_matrix();
+  /// Arm torques of the implicit PD drive for one Bullet step of length h_, applied with addJointTorque.
+  void apply_implicit_pd();
+  bool is_finger(int body) const;
 
   const RobotDescription& desc_;
   const ArticulationLayout& layout_;
@@ -128,6 +133,9 @@ class PhysicsWorld {
   std::vector<std::unique_ptr<btRigidBody>> objects_;
 
   Eigen::VectorXd q_target_;
+  std::vector<int> arm_dofs_;       // bodies driven as arm joints (every non-finger body)
+  Eigen::MatrixXd mass_;            // joint-space inertia scratch (num_dofs square)
+  Eigen::MatrixXd jac_scratch_;     // 6 x num_dofs scratch
   std::vector<Eigen::Vector3d> finger_forces_;  // [finger slot * num objects + object]
 };
 

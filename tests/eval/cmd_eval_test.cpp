@@ -116,7 +116,7 @@ TEST_F(CmdEvalTest, GateCheckBadInput) {
   }
   std::ostringstream e2;
   EXPECT_EQ(run_gate_check({(root_ / "g0.json").string(), results(), ""}, out, e2), 2);
-  EXPECT_THAT(e2.str(), HasSubstr("only gate1 verdicts can be recomputed"));
+  EXPECT_THAT(e2.str(), HasSubstr("only gate1 and promotion verdicts can be recomputed"));
   // gate0 verdict files compare file to file
   {
     std::ofstream f(root_ / "g0_now.json");

@@ -175,6 +175,60 @@ TEST(Promotion, ParetoPointOnProbeCost) {
   EXPECT_EQ(promotion_verdict(base, cand, 1000).decision, "reject");
 }
 
+TEST(Promotion, ACheaperTieAtTheFloorPromotesNothing) {
+  // 0.000 vs 0.000 with fewer probe steps: cheaper, "not less successful", and meaningless
+  const auto cand = with_probes(make_records("pick_cube", "long_lag", "c", kSeeds, 100, [](int) { return false; }), 1);
+  const auto base = with_probes(make_records("pick_cube", "long_lag", "b", kSeeds, 100, [](int) { return false; }), 6);
+  const auto v = promotion_verdict(cand, base, 1000);
+  EXPECT_FALSE(v.pareto_rule);
+  EXPECT_EQ(v.decision, "reject");
+  EXPECT_THAT(v.reason, HasSubstr("below the Pareto floor 0.3000"));
+  // the same tie just above the floor is a Pareto point
+  const auto cand2 = with_probes(make_records("pick_cube", "long_lag", "c", kSeeds, 100, [](int k) { return k % 10 < 3; }), 1);
+  const auto base2 = with_probes(make_records("pick_cube", "long_lag", "b", kSeeds, 100, [](int k) { return k % 10 < 3; }), 6);
+  EXPECT_EQ(promotion_verdict(cand2, base2, 1000).decision, "promote");
+  // and just below it is not
+  const auto cand3 = with_probes(make_records("pick_cube", "long_lag", "c", kSeeds, 100, [](int k) { return k % 10 < 2; }), 1);
+  const auto base3 = with_probes(make_records("pick_cube", "long_lag", "b", kSeeds, 100, [](int k) { return k % 10 < 2; }), 6);
+  EXPECT_EQ(promotion_verdict(cand3, base3, 1000).decision, "reject");
+}
+
+TEST(Promotion, ReportCellsStateTheirEpisodes) {
+  const auto cand = with_probes(make_records("pick_cube", "seen", "c", kSeeds, 40, [](int k) { return k % 4 != 0; }), 2);
+  const auto base = with_probes(make_records("pick_cube", "seen", "b", kSeeds, 40, [](int k) { return k % 4 != 0; }), 6);
+  auto all = cand;
+  all.insert(all.end(), base.begin(), base.end());
+  const auto j = promotion_report(all, "c", "b", 500);
+  EXPECT_EQ(j["cells"]["pick_cube/seen"]["episodes"], 120);
+  EXPECT_EQ(j["rules"]["pareto_success_floor"], 0.3);
+}
+
+TEST(VerdictFiles, AVerdictOnFewerEpisodesThanExpectedIsARegression) {
+  const nlohmann::json expected = {{"gate", "promotion"},
+                                   {"cells",
+                                    {{"a/seen", {{"verdict", "promote"}, {"episodes", 600}}},
+                                     {"b/seen", {{"verdict", "reject"}, {"episodes", 600}}},
+                                     {"c/seen", {{"verdict", "promote"}, {"episodes", 600}}}}}};
+  const nlohmann::json actual = {{"gate", "promotion"},
+                                 {"cells",
+                                  {{"a/seen", {{"verdict", "promote"}, {"episodes", 60}}},
+                                   {"b/seen", {{"verdict", "reject"}, {"episodes", 60}}},
+                                   {"c/seen", {{"verdict", "promote"}, {"episodes", 600}}}}}};
+  const auto changes = compare_verdicts(expected, actual);
+  ASSERT_EQ(changes.size(), 3u);
+  EXPECT_TRUE(changes[0].regression);
+  EXPECT_THAT(changes[0].line, HasSubstr("rests on 60 episodes, fewer than the expected verdict's 600"));
+  EXPECT_TRUE(changes[1].regression);  // even a negative verdict cannot be checked on fewer episodes
+  EXPECT_FALSE(changes[2].regression);
+  // gate 1 cells count the smaller of their two Wilson totals
+  const nlohmann::json e1 = {{"gate", "gate1"},
+                             {"cells", {{"a/seen", {{"verdict", "pass"}, {"oracle", {{"total", 512}}}, {"no_adapt", {{"total", 512}}}}}}}};
+  const nlohmann::json a1 = {{"gate", "gate1"},
+                             {"cells", {{"a/seen", {{"verdict", "pass"}, {"oracle", {{"total", 512}}}, {"no_adapt", {{"total", 16}}}}}}}};
+  EXPECT_TRUE(compare_verdicts(e1, a1)[0].regression);
+  EXPECT_FALSE(compare_verdicts(e1, e1)[0].regression);
+}
+
 TEST(Promotion, SafetyRegressionBlocksPromotion) {
   auto cand = make_records("pick_cube", "seen", "c", kSeeds, 100, [](int k) { return k % 10 < 9; });
   const auto base = make_records("pick_cube", "seen", "b", kSeeds, 100, [](int k) { return k % 10 < 5; });

@@ -34,7 +34,7 @@ TEST(JobSpec, CanonicalJsonIsPinned) {
   const std::string expected =
       "{\"backbone\":{\"name\":\"expert\",\"sha256\":\"" + std::string(64, 'b') +
       "\"},\"calibration_sha256\":null,\"episodes\":256,\"method\":{\"name\":\"oracle\",\"params\":{}},"
-      "\"pool\":null,\"rotation_mode\":\"live\",\"schema_version\":\"1.0\",\"seed\":20260718,"
+      "\"pool\":null,\"profile\":\"maniskill\",\"rotation_mode\":\"live\",\"schema_version\":\"2.0\",\"seed\":20260718,"
       "\"split\":{\"contracts\":2,\"name\":\"seen\",\"sha256\":\"" + std::string(64, 'a') + "\"},\"task\":\"pick_cube\"}";
   EXPECT_EQ(job_canonical_json(golden_job()), expected);
   EXPECT_EQ(job_id(golden_job()), sha256_hex(expected));
@@ -43,7 +43,22 @@ TEST(JobSpec, CanonicalJsonIsPinned) {
 TEST(JobSpec, IdIsStable) {
   // golden: computed independently with Python json.dumps(obj, sort_keys=True, separators=(",",":"))
   // + hashlib.sha256; changes only with a deliberate schema change
-  EXPECT_EQ(job_id(golden_job()), "20e911668bd35799737385526e46a25d49f3e1fd56317a7edf864aa41da89a43");
+  EXPECT_EQ(job_id(golden_job()), "f0052a82b78ea3758c53f716282ca843abb666b8acdb64ec835a8b69d3c6b5dd");
+}
+
+TEST(JobSpec, ProfilesAreTheSimulatorsAndUnknownOnesAreRejected) {
+  JobSpec j = golden_job();
+  j.profile = "physx";
+  try {
+    validate_job(j, "plan.json");
+    FAIL() << "an unknown profile was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("profile"), std::string::npos) << e.what();
+  }
+  j.profile = "ideal";
+  EXPECT_NO_THROW(validate_job(j));
+  const auto back = job_from_json(job_to_json(j), "roundtrip");
+  EXPECT_EQ(back.profile, "ideal");
 }
 
 TEST(JobSpec, EveryFieldChangesTheId) {
@@ -60,6 +75,7 @@ TEST(JobSpec, EveryFieldChangesTheId) {
       {"pool", [](JobSpec& j) { j.pool = PoolRef{"reference9", std::string(64, 'e')}; }},
       {"calibration", [](JobSpec& j) { j.calibration_sha256 = std::string(64, 'f'); }},
       {"rotation_mode", [](JobSpec& j) { j.rotation_mode = "identity"; }},
+      {"profile", [](JobSpec& j) { j.profile = "ideal"; }},
       {"seed", [](JobSpec& j) { j.seed = 20260719; }},
       {"episodes", [](JobSpec& j) { j.episodes = 255; }},
   };

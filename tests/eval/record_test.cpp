@@ -44,8 +44,8 @@ TEST(EpisodeRecord, SerialisesAsOneCanonicalLine) {
       "{\"backbone\":\"expert\",\"backbone_sha256\":\"" + sha256_hex("expert") +
       "\",\"contract_index\":1,\"contract_sha256\":\"" + sha256_hex("contract") +
       "\",\"episode_index\":7,\"job_id\":\"" + sha256_hex("job") +
-      "\",\"method\":\"oracle\",\"probe_displacement\":0.0125,\"probe_steps\":6,\"return\":12.5,"
-      "\"safety_flags\":[\"workspace_exit\"],\"schema_version\":\"1.0\",\"seed\":20260718,\"split\":\"seen\","
+      "\",\"method\":\"oracle\",\"probe_displacement\":0.0125,\"probe_steps\":6,\"profile\":\"maniskill\",\"return\":12.5,"
+      "\"safety_flags\":[\"workspace_exit\"],\"schema_version\":\"1.1\",\"seed\":20260718,\"split\":\"seen\","
       "\"steps\":50,\"success_at_end\":false,\"success_once\":true,\"task\":\"pick_cube\"}";
   EXPECT_EQ(line, expected);
   EXPECT_EQ(line.find('\n'), std::string::npos);

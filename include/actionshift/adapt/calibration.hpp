@@ -35,9 +35,12 @@ struct ResponseCalibration {
   int steps{0};                    ///< control steps per episode
   std::uint64_t seed{0};           ///< calibration seed
   std::string rotation_mode{"live"};  ///< how canonical rotation commands were applied (always live: unwrapped env)
+  std::string profile{"maniskill"};   ///< simulator fidelity profile it was measured on
+  std::string protocol{"reference_walk"};  ///< "reference_walk" (8 walks x 64 steps) or "episodes"
 
   ResponseModel model() const { return {fit.alpha, fit.sigma}; }
-  /// Canonical JSON (sorted keys, Python-repr floats; schema "actionshift-calibration/1").
+  /// Canonical JSON (sorted keys, Python-repr floats; schema "actionshift-calibration/2", which adds
+  /// "profile" and "protocol" to /1; /1 files still load, as profile "ideal", protocol "episodes").
   std::string to_json() const;
   /// sha256 of to_json(): the calibration hash in job specs.
   std::string sha256() const;

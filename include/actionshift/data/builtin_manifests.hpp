@@ -20,10 +20,10 @@ std::optional<std::string_view> builtin_manifest_text(std::string_view name);
 /// name. Throws InputError naming the argument and listing the built-in names if neither.
 Manifest resolve_manifest(const std::string& name_or_path);
 
-/// The exact text of the committed response calibration of a task (configs/calibration/<task>.json),
-/// or nullopt if this build has none for it.
-std::optional<std::string_view> builtin_calibration_text(std::string_view task);
-/// Tasks with a built-in calibration, sorted.
+/// The exact text of the committed response calibration of a task on a simulator fidelity profile
+/// (configs/calibration/<profile>/<task>.json), or nullopt if this build has none for them.
+std::optional<std::string_view> builtin_calibration_text(std::string_view task, std::string_view profile = "maniskill");
+/// Built-in calibrations as "<profile>/<task>", sorted.
 std::vector<std::string> builtin_calibration_tasks();
 
 }  // namespace actionshift::data

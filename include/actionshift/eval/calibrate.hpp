@@ -10,9 +10,27 @@
 
 namespace actionshift::eval {
 
+/// How the random actions are laid out.
+enum class CalibrationProtocol {
+  /// The public reference implementation's protocol: `episodes` independent random walks (8) of
+  /// `steps` control steps (64) each, no resets and no horizon or workspace stop inside a walk,
+  /// uniform actions in [-1, 1] on all 7 channels (gripper included); the response of step k-1 -> k
+  /// is paired with action k, so the first step of each walk gives no sample (8 x 63 = 504 samples).
+  kReferenceWalk,
+  /// The project's earlier protocol: `episodes` task episodes (16) of at most `steps` (50, capped at
+  /// the horizon), each reset, ended early by a safety check; every step gives a sample.
+  kEpisodes,
+};
+
+/// Name of a protocol as recorded in calibration files: "reference_walk" or "episodes".
+std::string_view protocol_name(CalibrationProtocol p);
+/// Inverse of protocol_name; throws std::invalid_argument naming the known protocols.
+CalibrationProtocol parse_protocol(std::string_view name);
+
 struct CalibrationOptions {
-  int episodes{16};                 ///< episodes of random actions
-  int steps{50};                    ///< control steps per episode (at most the task horizon)
+  CalibrationProtocol protocol{CalibrationProtocol::kReferenceWalk};
+  int episodes{8};                  ///< random walks (reference: 8 environments) or episodes
+  int steps{64};                    ///< control steps per walk (reference: 64) or per episode
   std::uint64_t seed{20260720};     ///< the reference's calibration seed
 };
 
@@ -20,10 +38,9 @@ struct CalibrationOptions {
 /// Throws std::invalid_argument if the layout has no 7-wide tcp_pose field.
 adapt::TcpSlice tcp_slice(const sim::ObservationLayout& layout);
 
-/// Runs the calibration: episode e resets with derive_seed({seed, e}) and draws uniform actions in
-/// [−1, 1]^7 from Rng(derive_seed({seed, e, 1})); each step's TCP response is paired with its
-/// action; an episode ended by a safety check contributes the steps before it.
-/// Deterministic in (model, options).
+/// Runs the calibration on the model's fidelity profile: walk/episode e resets with
+/// derive_seed({seed, e}) and draws uniform actions in [-1, 1]^7 from Rng(derive_seed({seed, e, 1}));
+/// each response is paired with its action as the protocol says. Deterministic in (model, options).
 adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model, const CalibrationOptions& options = {});
 
 }  // namespace actionshift::eval

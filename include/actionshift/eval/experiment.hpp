@@ -15,12 +15,12 @@ namespace actionshift::eval {
 
 /// Resolves split, pool, backbone and calibration names the way `run` and `plan` do:
 /// split/pool: a manifest file path or a built-in name; backbone: policy::make_policy;
-/// calibration: the task's built-in calibration (configs/calibration/<task>.json) for methods that
-/// need one. Unknown names throw InputError.
+/// calibration: the task's built-in calibration on the job's profile
+/// (configs/calibration/<profile>/<task>.json) for methods that need one. Unknown names throw InputError.
 PlanResolver default_resolver();
 
-/// The task's built-in response calibration. Throws InputError if this build has none.
-adapt::ResponseCalibration builtin_calibration(const std::string& task);
+/// The task's built-in response calibration on a fidelity profile. Throws InputError if this build has none.
+adapt::ResponseCalibration builtin_calibration(const std::string& task, const std::string& profile = "maniskill");
 
 /// Method parameters with defaults filled in (adapt::resolve_method_params) as canonical JSON text:
 /// what enters the job spec, so a changed default changes the job id.

@@ -84,6 +84,9 @@ std::string gate1_to_markdown(const Gate1Report& report);
 inline constexpr double kPromotionMinGain = 0.05;
 /// A one-seed result below this success rate is never promoted (pruning rule).
 inline constexpr double kPruneSuccessFloor = 0.3;
+/// A Pareto promotion needs at least this candidate success: a cheaper method that ties a failing
+/// baseline (for example 0.000 vs 0.000 on a split nothing solves) is not an improvement.
+inline constexpr double kParetoSuccessFloor = 0.3;
 /// Largest tolerated increase of the flagged-episode rate before it counts as a safety regression.
 inline constexpr double kSafetyRegressionTolerance = 0.01;
 
@@ -97,7 +100,8 @@ struct PromotionVerdict {
   double candidate_probe_steps{0.0}, baseline_probe_steps{0.0};  ///< mean probe steps (the cost axis)
   double candidate_flag_rate{0.0}, baseline_flag_rate{0.0};      ///< episodes with a safety flag
   bool five_point_rule{false};    ///< estimate ≥ 0.05 and the 95 % interval excludes 0
-  bool pareto_rule{false};        ///< strictly fewer mean probe steps and a paired success estimate ≥ 0
+  bool pareto_rule{false};        ///< strictly fewer mean probe steps, a paired success estimate ≥ 0, candidate
+                                  ///< success ≥ kParetoSuccessFloor (so 0.000 vs 0.000 promotes nothing)
   bool safety_regression{false};  ///< flag rate up by > 0.01, or its paired interval lies above 0
 };
 

@@ -16,7 +16,7 @@
 namespace actionshift::eval {
 
 /// Version of the job spec canonical JSON.
-inline constexpr std::string_view kJobSchemaVersion = "1.0";
+inline constexpr std::string_view kJobSchemaVersion = "2.0";
 
 /// A split manifest by name and content hash, with the number of evaluation contracts it holds.
 struct SplitRef {
@@ -44,6 +44,10 @@ struct PoolRef {
 /// "live": tool frame = live TCP orientation (default, DESIGN §3); "identity": R = I (reference v1).
 inline constexpr std::string_view kRotationModes[] = {"live", "identity"};
 
+/// Accepted values of JobSpec::profile: the simulator fidelity profiles (sim::profile_names()).
+/// "maniskill" (default): ManiSkill's one-step IK and PD drives; "ideal": converged IK, first-order servo.
+inline constexpr std::string_view kProfiles[] = {"maniskill", "ideal"};
+
 /// Everything that determines a job's episodes. Equality of ids (not of structs) is identity:
 /// `method_params` is compared as text here but hashed in canonical form.
 struct JobSpec {
@@ -55,6 +59,7 @@ struct JobSpec {
   std::optional<PoolRef> pool;               ///< declared pool, or none
   std::optional<std::string> calibration_sha256;  ///< 64-hex calibration hash, or none
   std::string rotation_mode{"live"};         ///< one of kRotationModes
+  std::string profile{"maniskill"};          ///< one of kProfiles: the simulator fidelity profile
   std::uint64_t seed{0};                     ///< experimental seed
   std::int64_t episodes{0};                  ///< number of episodes (> 0)
   bool operator==(const JobSpec&) const = default;
@@ -64,7 +69,7 @@ struct JobSpec {
 void validate_job(const JobSpec& job, const std::string& source = "job");
 
 /// The hashed object: {"backbone":{"name","sha256"},"calibration_sha256","episodes",
-/// "method":{"name","params"},"pool":{"name","sha256"}|null,"rotation_mode","schema_version",
+/// "method":{"name","params"},"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
 /// "seed","split":{"contracts","name","sha256"},"task"}. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 

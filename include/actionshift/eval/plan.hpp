@@ -25,7 +25,8 @@ struct MethodEntry {
 };
 
 /// An experiment as written in YAML. Keys: name, tasks, splits, methods, seeds, episodes, backbone
-/// (required); pool (default null), rotation_mode (default "live"), description (free text).
+/// (required); pool (default null), rotation_mode (default "live"), profile (simulator fidelity,
+/// default "maniskill"), description (free text).
 struct Experiment {
   std::string source;                 ///< file it was read from (for messages)
   std::string source_sha256;          ///< SHA-256 of the file bytes
@@ -41,6 +42,7 @@ struct Experiment {
   /// Per-split pools (YAML `pool: {split: pool, ...}`, every split named); overrides `pool`.
   std::map<std::string, std::optional<std::string>> split_pools;
   std::string rotation_mode{"live"};  ///< "live" or "identity"
+  std::string profile{"maniskill"};   ///< simulator fidelity profile: "maniskill" or "ideal"
 };
 
 /// Parse experiment YAML text. `source` names it in errors.
@@ -58,7 +60,8 @@ struct PlanResolver {
   std::function<SplitRef(const std::string& task, const std::string& split)> split;
   std::function<BackboneRef(const std::string& task, const std::string& backbone)> backbone;
   std::function<PoolRef(const std::string& pool)> pool;
-  std::function<std::optional<std::string>(const std::string& task, const MethodEntry& method)> calibration;
+  std::function<std::optional<std::string>(const std::string& task, const MethodEntry& method, const std::string& profile)>
+      calibration;
   std::function<void(const MethodEntry& method)> check_method;
   /// If set: the method's parameters as they enter the job spec (e.g. with defaults filled in, so
   /// a changed default changes the job id). Unset: the parameters as written.
@@ -76,6 +79,7 @@ struct JobRequest {
   std::string backbone{"expert"};     ///< backbone name
   std::optional<std::string> pool;    ///< pool name, or none
   std::string rotation_mode{"live"};  ///< "live" or "identity"
+  std::string profile{"maniskill"};   ///< simulator fidelity profile
   std::uint64_t seed{20260718};       ///< experimental seed
   std::int64_t episodes{256};         ///< episodes
 };

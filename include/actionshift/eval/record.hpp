@@ -12,12 +12,12 @@
 namespace actionshift::eval {
 
 /// Version of the episode record schema written by this library.
-inline constexpr std::string_view kRecordSchemaVersion = "1.0";
+inline constexpr std::string_view kRecordSchemaVersion = "1.1";
 
 /// One evaluated episode. A value type: the runner stamps the job fields, the episode function fills
 /// the outcome fields.
 struct EpisodeRecord {
-  std::string schema_version{kRecordSchemaVersion};  ///< "1.0"
+  std::string schema_version{kRecordSchemaVersion};  ///< "1.1" (1.1 added `profile`)
   std::string job_id;           ///< 64-hex job id (eval/job.hpp)
   std::string task;             ///< task name, e.g. "pick_cube"
   std::string split;            ///< split name, e.g. "seen"
@@ -35,6 +35,7 @@ struct EpisodeRecord {
   std::vector<std::string> safety_flags;  ///< names of the safety checks that fired (unique)
   std::string backbone;         ///< backbone (frozen policy) name
   std::string backbone_sha256;  ///< 64-hex hash of the backbone's weights or description
+  std::string profile{"maniskill"};  ///< simulator fidelity profile of the job ("maniskill", "ideal")
 
   bool operator==(const EpisodeRecord&) const = default;
 };

@@ -68,6 +68,7 @@ Gate0Parity gate0_parity(std::int64_t ref_successes, std::int64_t ref_total, std
 
 /// Settings of a Gate 0 run.
 struct Gate0Run {
+  std::string profile{"maniskill"};  ///< simulator fidelity profile (sim::profile_config)
   std::int64_t episodes{300};
   std::uint64_t seed{20260718};
   double floor{-1.0};  ///< < 0: gate0_floor(task)
@@ -79,6 +80,7 @@ struct Gate0Run {
 /// A Gate 0 verdict for one backbone and task.
 struct Gate0Verdict {
   std::string backbone, backbone_sha256, task;
+  std::string profile{"maniskill"};  ///< simulator fidelity profile the episodes ran on
   std::uint64_t seed{0};
   std::int64_t episodes{0};
   Gate0Competence competence;

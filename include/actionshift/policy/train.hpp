@@ -26,6 +26,7 @@ namespace actionshift::policy {
 /// Training settings (defaults: the committed backbones, docs/backbones.md).
 struct TrainBcOptions {
   sim::TaskId task{sim::TaskId::kPickCube};
+  std::string profile{"maniskill"};      ///< simulator fidelity profile of the rollouts
   bool delay_aware{false};               ///< history of 4 actions, random lag {0,1,2,4}
   std::uint64_t seed{20260718};          ///< weights init, data collection, minibatches
   std::vector<int> hidden{256, 256};     ///< hidden layer widths (tanh)

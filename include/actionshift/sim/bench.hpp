@@ -6,6 +6,7 @@
 #include "actionshift/sim/task.hpp"
 
 #include <cstdint>
+#include <string_view>
 
 namespace actionshift::sim {
 
@@ -17,6 +18,7 @@ struct EnvThroughput {
 
 /// Run `steps_per_thread` control steps on each of `threads` threads (one Env each, shared model),
 /// episodes of the scripted grasp-and-lift seeded from `seed`; resets are included in the time.
-EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, int threads, std::uint64_t seed = 1);
+EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, int threads, std::uint64_t seed = 1,
+                                     std::string_view profile = "maniskill");
 
 }  // namespace actionshift::sim

@@ -31,10 +31,21 @@ PoseCommand interpret_pose_command(const Eigen::Matrix<double, 6, 1>& pose);
 /// Target TCP pose (base frame) for a command: p + dp, Exp(dr) R.
 Eigen::Isometry3d target_pose(const Eigen::Isometry3d& tcp_in_base, const PoseCommand& cmd);
 
-/// Damped-least-squares CLIK settings.
+/// How a TCP target becomes joint targets.
+enum class IkMode {
+  /// ManiSkill's GPU `pd_ee_delta_pose` path (the `maniskill` profile): ONE damped-least-squares
+  /// step at the current joints, dq = (J^T J + damping I)^-1 J^T dx with dx = [dp; dtheta], no
+  /// iteration and no joint-limit clamping (the simulator's joint limits act instead).
+  kSingleStep,
+  /// Iterate the damped least squares to convergence within the joint limits (the `ideal` profile).
+  kConverged,
+};
+
+/// Damped-least-squares settings.
 struct IkOptions {
+  IkMode mode{IkMode::kSingleStep};  ///< one step (ManiSkill) or converged
   int max_iterations{30};    ///< damped-least-squares iterations
-  double damping{1e-4};      ///< minimum lambda^2 added to J J^T (raised when a step fails)
+  double damping{1e-4};      ///< lambda: ManiSkill's 1e-4 for the single step; the minimum lambda^2 added to J J^T when converging
   double max_step{0.2};      ///< [rad] largest joint change per iteration
   double tolerance{1e-10};   ///< stop when |error| (m and rad stacked) is below this
 };
@@ -51,5 +62,11 @@ struct IkResult {
 /// iterate seen (q0 clamped if nothing improves). Allocation-free.
 IkResult solve_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
                   const Eigen::Isometry3d& target, const IkOptions& options = {});
+
+/// ManiSkill's single damped-least-squares step for a pose command at joints q0:
+/// q0 + (J^T J + options.damping I)^-1 J^T [dp; dtheta], J the 6 x dof TCP Jacobian in the root frame.
+/// Not clamped to the joint limits. Allocation-free.
+IkResult single_step_ik(const KinematicChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                        const PoseCommand& cmd, const IkOptions& options = {});
 
 }  // namespace actionshift::sim

@@ -24,6 +24,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace actionshift::sim {
 
@@ -61,10 +62,15 @@ struct RobotNames {
   std::string right_finger_joint{"panda_finger_joint2"};
 };
 
-/// Settings of an environment model.
+/// The fidelity profile of the default EnvConfig.
+inline constexpr std::string_view kDefaultProfile = "maniskill";
+
+/// Settings of an environment model. The defaults are the `maniskill` fidelity profile.
 struct EnvConfig {
+  std::string profile{kDefaultProfile};       ///< name of the fidelity profile these settings came from (recorded, hashed by jobs)
   PhysicsConfig physics;                      ///< Bullet and drive settings
   IkOptions ik;                               ///< controller IK
+  int horizon{0};                             ///< control steps per episode; 0 = the task's horizon (calibration walks use more)
   WorkspaceBox workspace;                     ///< fail-closed TCP box
   double max_action_magnitude{100.0};         ///< |canonical entry| above this ends the episode (normalised units)
   double max_joint_speed{100.0};              ///< [rad/s] or [m/s]; above: unstable_state
@@ -72,6 +78,18 @@ struct EnvConfig {
   Eigen::Vector3d robot_base{-0.615, 0.0, 0.0};  ///< robot base position in the world (identity orientation)
   RobotNames names;
 };
+
+/// Names of the fidelity profiles, default first: "maniskill", "ideal".
+std::vector<std::string> profile_names();
+
+/// The settings of a named fidelity profile (docs/sim.md "Fidelity profiles"):
+/// - "maniskill" (default): what ManiSkill's GPU pd_ee_delta_pose path and PhysX drives do to the arm:
+///   one damped-least-squares IK step per control step, implicit second-order PD drives with the link
+///   inertia and the 100 N m force limit, joint limits enforced by the simulator;
+/// - "ideal": IK iterated to convergence within the joint limits and a first-order velocity servo,
+///   the project's original, cleaner response.
+/// Throws std::invalid_argument naming the known profiles for any other name.
+EnvConfig profile_config(std::string_view name);
 
 /// Immutable description of one task's environment, shared by every worker thread.
 class EnvModel {
@@ -83,10 +101,11 @@ class EnvModel {
   ~EnvModel();
 
   TaskId task() const { return task_; }
-  int horizon() const { return task_horizon(task_); }                    ///< control steps per episode
+  int horizon() const { return config_.horizon > 0 ? config_.horizon : task_horizon(task_); }  ///< control steps per episode
   const ObservationLayout& layout() const { return observation_layout(task_); }
   const EnvConfig& config() const { return config_; }
   const RobotDescription& robot() const { return *robot_; }
+  const std::shared_ptr<const RobotDescription>& robot_ptr() const { return robot_; }  ///< shared description
   const KinematicChain& arm() const { return arm_; }                      ///< robot base -> TCP
   /// Rest joint configuration of the task (9): ManiSkill's keyframe (joint 7 = -pi/4 for stack and peg).
   Eigen::Matrix<double, 9, 1> rest_qpos() const;

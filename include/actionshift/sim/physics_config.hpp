@@ -6,6 +6,17 @@
 
 namespace actionshift::sim {
 
+/// How the arm's joint drives turn joint position targets into motion.
+enum class ArmDrive {
+  /// PhysX-style second-order PD drive (the `maniskill` profile): torque K (q* - q) - D qdot, solved
+  /// implicitly with the arm's joint-space inertia and clipped to the force limit, so the arm carries
+  /// momentum from one control step into the next and saturates on large commands.
+  kImplicitPd,
+  /// First-order velocity servo qdot* = (K / D)(q* - q) (the `ideal` profile): the dominant mode of the
+  /// overdamped PD without the link inertia; each control step's motion depends on that step's target only.
+  kVelocityServo,
+};
+
 /// Physics and drive settings. Defaults reproduce ManiSkill's `panda` + pd_ee_delta_pose intent
 /// with the Bullet settings that make a grasp hold (dependency notes section 3).
 struct PhysicsConfig {
@@ -24,7 +35,8 @@ struct PhysicsConfig {
   bool finger_gear{true};             ///< btMultiBodyGearConstraint between the fingers (mimic)
   bool friction_anchors{true};        ///< CF_HAS_FRICTION_ANCHOR on fingers and objects
   double contact_processing_threshold{0.005};  ///< [m] manifold points farther apart than this make no solver rows
-  bool arm_joint_limits{false};       ///< limit constraints on the arm joints too (the IK keeps targets inside; fingers always)
+  ArmDrive arm_drive{ArmDrive::kImplicitPd};  ///< arm drive model (fingers always use the force-capped servo)
+  bool arm_joint_limits{true};        ///< limit constraints on the arm joints too (PhysX enforces the URDF limits; fingers always)
 };
 
 }  // namespace actionshift::sim
