@@ -108,6 +108,30 @@ print("- The `ideal` profile's earlier tournament (previous calibration protocol
 print("Success is success_once with its Wilson 95 % interval over the seeds; probe = mean probe steps per episode;"
       " disp. = mean TCP translation during probes [m].\n")
 
+# ---- where the benchmark discriminates
+print("## Does the benchmark discriminate?\n")
+print("The largest belief-family spread (max - min success over exact, fixed, random, entropy, DualABI) per split, and the")
+print("paired entropy - exact difference on PickCube, from the promotion verdict files:\n")
+print("| split | pool | largest spread over the tasks | PickCube entropy - exact [95 %] |")
+print("|---|---|---|---|")
+for split in ref_splits + gen_splits:
+    best = None
+    for task in tasks:
+        rates = [by[(task, split, m)]["success_once"]["rate"] for m in methods if m not in ("oracle", "no_adapt") and (task, split, m) in by]
+        if rates and (best is None or max(rates) - min(rates) > best[0]):
+            best = (max(rates) - min(rates), task)
+    d = diff("entropy_probes", "exact_belief", "pick_cube", split)
+    ds = "—" if not d else f"{d['difference']['estimate']:+.3f} [{d['difference']['lower']:+.3f}, {d['difference']['upper']:+.3f}]"
+    pool = "reference9" if split.startswith("reference") else "full"
+    print(f"| {split} | {pool} | {best[0]:.3f} ({best[1]}) | {ds} |" if best else f"| {split} | {pool} | — | {ds} |")
+print()
+print("Reading: on the reference splits with the nine-contract pool every belief method sits at 0.98-1.00 on Pick, Push and")
+print("Pull: with this simulator's response (per-step alpha/sigma 3-5 on the translation channels even on the `maniskill`")
+print("profile, against about 1 in the paper's ManiSkill runs; docs/sim.md §0) and the closed-loop scripted expert, the")
+print("first task steps identify one of nine contracts before a wrong one costs the episode. With the 180-contract `full`")
+print("pool on the generated splits the passive exact belief falls several points behind the probing methods: that is")
+print("where this benchmark separates the methods.\n")
+
 # ---- findings
 print("## The paper's findings, tested\n")
 print("Rule (fixed in this script): a finding about a paired difference is **reproduced** when our paired 95 % bootstrap")
@@ -191,7 +215,10 @@ for split in ref_splits + gen_splits:
         rates = [(m, by[(task, split, m)]["success_once"]["rate"]) for m in methods if m not in ("oracle", "no_adapt") and (task, split, m) in by]
         if rates:
             lo = min(rates, key=lambda x: x[1]); hi = max(rates, key=lambda x: x[1])
-            print(f"- {task}: belief-family spread {hi[1] - lo[1]:.3f} ({lo[0]} {lo[1]:.3f} to {hi[0]} {hi[1]:.3f}).")
+            if hi[1] - lo[1] < 1e-12:
+                print(f"- {task}: belief-family spread 0.000 (every method {hi[1]:.3f}).")
+            else:
+                print(f"- {task}: belief-family spread {hi[1] - lo[1]:.3f} ({lo[0]} {lo[1]:.3f} to {hi[0]} {hi[1]:.3f}).")
     print()
 
 print("## Paired differences and promotion verdicts (computed by `actionshift gate promote`)\n")
