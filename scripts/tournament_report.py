@@ -47,7 +47,7 @@ for split in splits:
     print()
 
 print("## Promotion verdicts (computed by `actionshift gate promote`)\n")
-print("Rules (DESIGN §8, `include/actionshift/eval/gates.hpp`): a one-seed result under 0.3 is pruned; a")
+print("Rules (docs/reference.md, *Gates*; `include/actionshift/eval/gates.hpp`): a one-seed result under 0.3 is pruned; a")
 print("safety regression rejects; fewer than three matched seeds asks for more seeds; otherwise the")
 print("candidate is promoted on >= 5 points over its matched baseline with the paired 95 % bootstrap")
 print("interval above 0, or on a success-vs-probe-cost Pareto point (fewer mean probe steps with a paired")
