@@ -46,7 +46,7 @@ struct GateCheckOptions {
 int run_gate_check(const GateCheckOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
 // `actionshift gate promote --candidate M --baseline M' --results DIR [--json] [--verdict FILE]`
-// Applies the promotion rules (DESIGN §8) per (task, split) cell holding both methods; prints the
+// Applies the promotion rules (docs/reference.md, *Gates*) per (task, split) cell holding both methods; prints the
 // table with its evidence and writes the verdict file (default DIR/promotion.<M>.vs.<M'>.json).
 // Exit 0 (the verdicts are the output; `gate check` turns a lost promotion into exit 1).
 struct GatePromoteOptions {

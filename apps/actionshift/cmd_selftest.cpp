@@ -167,7 +167,7 @@ int run(const SelftestOptions& o) {
     if (!st) throw InputError("", "selftest", err);
     note = run_sim(*st, hidden, o);
   } else {
-    so.frame_rotation = selftest::FrameRotation::kIdentity;  // the stand-in decodes with R = I (reference §11)
+    so.frame_rotation = selftest::FrameRotation::kIdentity;  // the stand-in decodes with R = I (docs/reference.md, *Self-test*)
     h.backend = "synthetic stand-in: alpha 1, sigma 0.05, R = I";
     h.unit = "synthetic units";
     st = selftest::SelfTest::create(so, &err);

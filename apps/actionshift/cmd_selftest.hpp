@@ -1,5 +1,5 @@
 #pragma once
-// `actionshift selftest`: plug-and-verify self-test (issue 7, reference §11), as a plain function.
+// `actionshift selftest`: plug-and-verify self-test (issue 7, docs/selftest.md), as a plain function.
 // Exit codes are the self-test's own: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. run_selftest
 // catches its own errors so that bad input is 3, not the CLI's generic 2.
 

@@ -248,7 +248,7 @@ int main(int argc, char** argv) {
   gate_check->callback([&] { action = [&] { return cli::run_gate_check(gc_o); }; });
   cli::GatePromoteOptions gp_o;
   auto* gate_promote = gate->add_subcommand(
-      "promote", "Promotion gate (DESIGN §8): a candidate method vs its matched baseline per task and split: >= 5 points\n"
+      "promote", "Promotion gate (docs/reference.md, section Gates): a candidate method vs its matched baseline per task and split: >= 5 points\n"
                  "(paired 95 % bootstrap interval above 0) or a success-vs-probe-cost Pareto point, without a safety\n"
                  "regression; a one-seed result under 0.3 is never promoted; < 3 matched seeds: extend_seeds.");
   gate_promote->add_option("--candidate", gp_o.candidate, "Candidate method")->required();

@@ -96,7 +96,7 @@ struct SelfTest::Impl {
   // the next probe: fixed pulses, or the entropy-minimising axis pulse among the admissible ones:
   // - return balancing: a channel whose commanded raw sum is non-zero may only be pulsed back to zero;
   // - no saturation: no hypothesis holding posterior mass may decode the pulse beyond the controller's
-  //   clip range (|translation_i| <= 1, |rotation| <= 1, DESIGN §3), which the response model does not
+  //   clip range (|translation_i| <= 1, |rotation| <= 1, docs/semantics.md §1), which the response model does not
   //   describe (an absolute-target wiring turns +a then −a on one channel into a 2·scale·a step).
   // if nothing is admissible the balance rule alone decides
   Action choose(const Mat3& R) const {

@@ -13,7 +13,7 @@ using actionshift::testing::intent;
 using actionshift::testing::pick_like;
 using actionshift::testing::run_synthetic;
 
-// the reference pool with the truth moved to the end (reference §15 item 20: "truth last")
+// the reference pool with the truth moved to the end (a reference-implementation unit test, "truth last"; docs/reference.md, Pool belief)
 std::vector<Contract> pool_with_truth_last(const Contract& truth) {
   std::vector<Contract> pool;
   for (const auto& c : reference::pool9())
@@ -53,7 +53,7 @@ TEST(PoolBelief, PoolWithoutTruthDoesNotReachParity) {
 }
 
 TEST(PoolBelief, ReplicasMatchTheWrapperDecoderThroughAbsoluteToolLagGripperAndResets) {
-  // reference §15 item 21: replicas are bit-faithful copies of the environment's decoder
+  // invariant from the reference implementation's tests (docs/reference.md, Pool belief): replicas are bit-faithful copies of the environment's decoder
   auto f = reference::representative_contracts("unseen_composition")[0].fields();
   f.lag = 2;
   const Contract truth = Contract::make(f);
@@ -92,7 +92,7 @@ TEST(PoolBelief, StaysNormalisedAndFiniteUnderSurprisingEvidence) {
 }
 
 TEST(PoolBelief, MapEncodeRoundTripsAbsoluteTargets) {
-  // reference §15 item 22: once the MAP is the truth, encoding through it is exact
+  // invariant from the reference implementation's tests (docs/reference.md, Pool belief): once the MAP is the truth, encoding through it is exact
   const Contract truth = reference::representative_contracts("unseen_composition")[1];  // absolute
   ExactBeliefAdapter a(pool_with_truth_last(truth), pick_like());
   const auto run = run_synthetic(a, truth, pick_like(), 30, 3, /*noise_scale=*/0.0);

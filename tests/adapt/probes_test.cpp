@@ -26,7 +26,7 @@ void expect_values(const std::vector<double>& got, const std::vector<double>& wa
 }
 
 TEST(FixedProbes, PulseOrder) {
-  // reference §15 item 24: +0.5 on channel 0 at steps 0 and 12, −0.5 at step 6; gripper 0; L1 0.5
+  // the reference implementation's fixed-probe test (docs/reference.md, Probes): +0.5 on channel 0 at steps 0 and 12, −0.5 at step 6; gripper 0; L1 0.5
   EXPECT_EQ(fixed_probe_pulse(0, 0.5)[0], 0.5);
   EXPECT_EQ(fixed_probe_pulse(6, 0.5)[0], -0.5);
   EXPECT_EQ(fixed_probe_pulse(12, 0.5)[0], 0.5);
@@ -103,7 +103,7 @@ TEST(DualAbi, ReferenceA4PairwiseTaskErrorRegretAndExpectedFutureRegret) {
   }
 }
 
-// reference §15 item 24 (α = 1, σ = 0.05 as in its unit tests)
+// the reference implementation's entropy-probe test (docs/reference.md, Probes; α = 1, σ = 0.05 as in its unit tests)
 TEST(Probing, EveryStrategyIdentifiesTheTruthWithinBudget12AndProbesAreBounded) {
   for (auto s : {ProbeStrategy::kFixed, ProbeStrategy::kRandom, ProbeStrategy::kEntropy})
     for (const char* split : {"seen", "unseen_composition"})

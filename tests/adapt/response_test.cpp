@@ -32,7 +32,7 @@ TEST(Quaternion, RotvecRoundTripAndRelativeRotation) {
 }
 
 TEST(TcpResponse, TranslationAndRotationVector) {
-  // a layout with the position at offset 4 and the quaternion at 7 (reference §15 item 30 uses offset 4)
+  // a layout with the position at offset 4 and the quaternion at 7 (the reference implementation's calibration test uses offset 4)
   std::vector<double> prev(12, 0.0), cur(12, 0.0);
   prev[4] = 0.1, prev[5] = 0.2, prev[6] = 0.3;
   cur[4] = 0.15, cur[5] = 0.2, cur[6] = 0.25;

@@ -1,5 +1,5 @@
 // Google Benchmark for the sim layer: one control step with contact, reset, IK, and the
-// throughput fixture `actionshift bench env` uses. Shared-model fixture (STYLE 2.6).
+// throughput fixture `actionshift bench env` uses. Shared-model fixture (one immutable model, one Env per thread).
 #include "actionshift/sim/bench.hpp"
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"

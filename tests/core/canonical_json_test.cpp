@@ -47,7 +47,7 @@ TEST(CanonicalDump, SortedCompactAsciiLikePythonJsonDumps) {
 
 TEST(Sha256, KnownVectors) {
   EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  // reference §15 item 14
+  // golden vector from the reference implementation (docs/reference.md, Contracts)
   EXPECT_EQ(sha256_hex("{\"success\":true}\n"), "b493cdb3b30ea63f6a924f814dfccfcfe305dac02106f9994ce2bcb2e8ed28c4");
   EXPECT_TRUE(is_sha256_hex(sha256_hex("")));
   EXPECT_FALSE(is_sha256_hex("ABC"));

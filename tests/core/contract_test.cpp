@@ -21,7 +21,7 @@ TEST(Contract, IdentityCanonicalJsonAndHashMatchReference) {
 }
 
 TEST(Contract, ReferenceGoldenHashes) {
-  // reference §2.6 and §3
+  // golden hashes: docs/reference.md, Contracts
   const auto seen = reference::representative_contracts("seen");
   const auto unseen = reference::representative_contracts("unseen_composition");
   const auto lag = reference::representative_contracts("long_lag");
@@ -65,7 +65,7 @@ TEST(Contract, FromJsonCoercesIntegerScalesToFloat) {
   EXPECT_EQ(c.sha256(), Contract::identity().sha256());
 }
 
-// every validation rule, with the reference's message (reference §1.1)
+// every validation rule, with the reference's message (docs/reference.md, *Contracts*)
 struct BadCase {
   const char* json;
   const char* message;

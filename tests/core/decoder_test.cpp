@@ -46,7 +46,7 @@ TEST(Decoder, GoldenAbsoluteWithLag2) {
 }
 
 TEST(Decoder, ReferenceLag1Vector) {
-  // reference §1.6: perm (1,0)/sign (1,−1)/scale (0.5,2.0)/lag 1, raws [2,3] then [4,5]
+  // the reference implementation's decoder example (docs/reference.md, Contracts): perm (1,0)/sign (1,−1)/scale (0.5,2.0)/lag 1, raws [2,3] then [4,5]
   ContractFields f;
   f.permutation = {1, 0, 2, 3, 4, 5};
   f.sign = {1, -1, 1, 1, 1, 1};
@@ -60,7 +60,7 @@ TEST(Decoder, ReferenceLag1Vector) {
 }
 
 TEST(Decoder, ResetMaskClearsOnlySelectedEnv) {
-  // reference §1.6: absolute + lag 1, batch 2, reset env 0 on step 2 → env 0 outputs zeros,
+  // the reference implementation's decoder example (docs/reference.md, Contracts): absolute + lag 1, batch 2, reset env 0 on step 2 → env 0 outputs zeros,
   // env 1 outputs its first action's pose
   Decoder d(with_lag(Contract::identity(), 1, "absolute"), 2);
   Decoder::Batch raw(7, 2), out(7, 2);

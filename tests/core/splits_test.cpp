@@ -129,7 +129,7 @@ TEST(Splits, CommittedManifestsEqualTheGeneratorOutputAndPassEveryCheck) {
     EXPECT_EQ(ss.str(), splits::generate(rule).serialize()) << path << " differs from the generator";
     const Manifest m = Manifest::load(path.string());
     expect_all_ok(validate(m), path.string());
-    // the grammar grids cover every contract in every manifest (DESIGN §3)
+    // the grammar grids cover every contract in every manifest (docs/semantics.md)
     for (const auto* list : {&m.train(), &m.test()})
       for (const auto& r : *list) EXPECT_TRUE(grammar::violations(r.contract).empty()) << path;
   }

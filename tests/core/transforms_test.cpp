@@ -14,7 +14,7 @@ void expect_near(const Action& got, const Action& want, double tol) {
 }
 
 TEST(DecodePose, PermutationThenSignThenScaleIndexedByOutput) {
-  // reference §1.3 scaled up to 6 channels: perm (1,0,…), sign (1,−1,…), scale (0.5, 2.0, …)
+  // the reference implementation's decode example (docs/reference.md, Contracts) scaled up to 6 channels: perm (1,0,…), sign (1,−1,…), scale (0.5, 2.0, …)
   ContractFields f;
   f.permutation = {1, 0, 2, 3, 4, 5};
   f.sign = {1, -1, 1, 1, 1, 1};
@@ -53,7 +53,7 @@ TEST(Decode, GoldenAbsoluteToolContract) {
 }
 
 TEST(Decode, ToolFrameRotatesTranslationAndRotationAndGripperIsOnlyNegated) {
-  // reference §15 item 10: tool frame with a 90° z rotation maps x-translation to y
+  // invariant from the reference implementation's tests (docs/reference.md, Contracts): tool frame with a 90° z rotation maps x-translation to y
   auto f = Contract::identity().fields();
   f.frame = "tool";
   f.gripper_inverted = true;

@@ -93,7 +93,7 @@ TEST(Gate1, VerdictsPerCell) {
 }
 
 TEST(Gate1, PairedEstimateAndClaimStatus) {
-  // reference §15.17 analogue: oracle succeeds on every second episode, no_adapt never: estimate 0.5
+  // analogue of a reference-implementation gate test (docs/reference.md, Gates): oracle succeeds on every second episode, no_adapt never: estimate 0.5
   auto r = make_records("push_cube", "seen", "oracle", {1, 2}, 10, [](int k) { return k % 2 == 0; });
   r = concat(r, make_records("push_cube", "seen", "no_adapt", {1, 2}, 10, [](int) { return false; }));
   const auto report = gate1(r, 2000);

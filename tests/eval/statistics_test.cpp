@@ -28,7 +28,7 @@ TEST(Wilson, ReproducesReferenceValuesBitForBit) {
   EXPECT_EQ(d.rate, 0.5);
   EXPECT_EQ(d.successes, 50);
   EXPECT_EQ(d.total, 100);
-  // reference §7.6: two episodes, one success
+  // the reference implementation's summary example (docs/reference.md, Statistics): two episodes, one success
   const auto e = wilson_interval(1, 2);
   EXPECT_NEAR(e.lower, 0.0945312057, 5e-11);
   EXPECT_NEAR(e.upper, 0.9054687943, 5e-11);

@@ -6,7 +6,7 @@ set -euo pipefail
 BIN="$1"
 source "$2/tests/cli/lib.sh"
 
-# ---- synthetic demos (reference §11): verdict, exit code, diff text
+# ---- synthetic demos (docs/reference.md, *Self-test*): verdict, exit code, diff text
 demo() {  # NAME RC TEXT
   run "$BIN" selftest --demo "$1"
   expect_rc "$2" "demo $1"

@@ -1,4 +1,4 @@
-// decide_verdict as a pure function (reference §11): the six guarantees, the diff sentences and
+// decide_verdict as a pure function (docs/reference.md, *Self-test*): the six guarantees, the diff sentences and
 // the renderings.
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/selftest/library.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-/// \file The adapter interface (DESIGN §6): an adapter sits between the frozen backbone and the
+/// \file The adapter interface (docs/adapters.md): an adapter sits between the frozen backbone and the
 /// hidden-contract environment. Each step it turns the backbone's canonical intent into the raw
 /// action to send, then observes the raw action and the TCP response it caused.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Response calibration: per-channel gain α, noise σ and R² of the TCP response to random
-/// canonical actions on the unwrapped environment (reference §4.1). The calibration JSON's hash
+/// canonical actions on the unwrapped environment (docs/reference.md, *Calibration and the response model*). The calibration JSON's hash
 /// enters every job hash that uses it.
 
 #include "actionshift/adapt/response.hpp"

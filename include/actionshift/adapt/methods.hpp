@@ -1,9 +1,9 @@
 #pragma once
-/// \file The adapters of the pool-belief ladder (DESIGN §6; reference §5): no adaptation,
+/// \file The adapters of the pool-belief ladder (docs/adapters.md; docs/reference.md, *Probes* and *DualABI*): no adaptation,
 /// privileged oracle, passive exact belief, bounded probing (fixed, random, entropy) and DualABI.
 ///
-/// Two deliberate differences from the reference's probe preview (reference §5.2 quirk and
-/// §16.4), both on by default and switchable for parity tests:
+/// Two deliberate differences from the reference's probe preview (docs/reference.md, *Probes*;
+/// docs/adapters.md), both on by default and switchable for parity tests:
 /// - calibrated simulation: a hypothesis' simulated observation is α ⊙ its prediction (the
 ///   reference compares α-scaled predictions against the unscaled prediction);
 /// - lag-aware preview: a lagged hypothesis predicts what its FIFO releases this step (the
@@ -78,7 +78,7 @@ Action fixed_probe_pulse(int step, double amplitude);
 /// `mass` is covered or `max_active` are taken; returned in increasing index order.
 std::vector<int> active_hypotheses(const Eigen::VectorXd& probs, int max_active, double mass);
 
-/// Expected posterior entropy of each candidate (reference §5.2 step 2), over the active set.
+/// Expected posterior entropy of each candidate (docs/reference.md, *Probes*), over the active set.
 std::vector<double> expected_posterior_entropy(const PoolBelief& belief, const std::vector<Action>& candidates,
                                                const Mat3& R, const ProbeOptions& o);
 
@@ -120,7 +120,7 @@ class ProbingAdapter final : public Adapter {
   StepInfo last_;
 };
 
-/// DualABI (reference §5.3): probes only while the task regret of acting on the MAP exceeds τ
+/// DualABI (docs/reference.md, *DualABI*): probes only while the task regret of acting on the MAP exceeds τ
 /// (sticky stop), choosing the candidate that most reduces the expected regret over the last
 /// `window` canonical intents. The pairwise task error is computed over the active hypotheses only
 /// (ProbeOptions::max_active / active_mass), which keeps it tractable for large pools.
@@ -135,11 +135,11 @@ class DualAbiAdapter final : public Adapter {
   StepInfo last_step() const override { return last_; }
   const PoolBelief& belief() const { return belief_; }
 
-  /// Pairwise task error E[i][j] over `active` (reference §5.3), for the current recent window.
+  /// Pairwise task error E[i][j] over `active` (docs/reference.md, *DualABI*), for the current recent window.
   Eigen::MatrixXd pairwise_task_error(const std::vector<int>& active, const Mat3& R) const;
   /// Regret of acting on the MAP of `p` (over the active set): Σ_j p_j E[i*, j].
   static double regret(const Eigen::VectorXd& p, const Eigen::MatrixXd& E);
-  /// Expected future regret of each candidate (reference §5.3 step 5).
+  /// Expected future regret of each candidate (docs/reference.md, *DualABI*).
   std::vector<double> expected_future_regret(const std::vector<int>& active, const Eigen::MatrixXd& E,
                                              const Mat3& R) const;
   /// Push an intent into the recent window (the first push of an episode fills every slot).

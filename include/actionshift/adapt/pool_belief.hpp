@@ -1,5 +1,5 @@
 #pragma once
-/// \file Exact Bayesian belief over a declared pool of contracts (reference §4.3): one decoder
+/// \file Exact Bayesian belief over a declared pool of contracts (docs/reference.md, *Pool belief*): one decoder
 /// replica per hypothesis (its own tracked target and lag FIFO), Gaussian likelihood of the
 /// observed TCP response from the calibrated response model, MAP encoding.
 

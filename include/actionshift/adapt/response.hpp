@@ -1,6 +1,6 @@
 #pragma once
 /// \file The observable response of the robot to an action, and the calibrated Gaussian response
-/// model adapters use as likelihood (reference §4.1–§4.2).
+/// model adapters use as likelihood (docs/reference.md, *Calibration and the response model*).
 ///
 /// response = [TCP translation (world/base axes, m), rotation vector of q_cur ⊗ conj(q_prev) (rad)]
 /// between two consecutive observations. The calibrated model predicts response_c ≈ α_c·canonical_c

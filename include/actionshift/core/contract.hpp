@@ -1,6 +1,6 @@
 #pragma once
 /// \file The action contract: an immutable value type describing how a hidden interface re-maps
-/// raw action numbers before the controller sees them (reference §1.1, DESIGN §3).
+/// raw action numbers before the controller sees them (docs/semantics.md §2; docs/reference.md, *Contracts*).
 ///
 /// Fields (names are part of the JSON and hash format): `permutation` (output channel i reads raw
 /// channel permutation[i]), `sign` and `scale` (indexed by OUTPUT channel), `target` (delta or
@@ -51,7 +51,7 @@ class Contract {
   static Contract identity() { return Contract(); }
 
   /// Validates `f` and builds a contract. Throws std::invalid_argument with the reference's
-  /// message for the first violated rule (order as reference §1.1, plus our D == 6 and lag bound).
+  /// message for the first violated rule (order as the reference implementation's, docs/reference.md *Contracts*, plus our D == 6 and lag bound).
   static Contract make(const ContractFields& f) {
     std::string err;
     auto c = try_make(f, &err);
@@ -170,7 +170,7 @@ class Contract {
   std::string sha256() const { return sha256_hex(to_json()); }
 
   /// Field names that differ from identity, in the fixed order permutation, sign, scale, target,
-  /// frame, lag, gripper (note: "gripper", not "gripper_inverted"; reference §1.8).
+  /// frame, lag, gripper (note: "gripper", not "gripper_inverted"; docs/reference.md, Contracts).
   std::vector<std::string> composition_signature() const {
     std::vector<std::string> s;
     const Contract id;
@@ -238,7 +238,7 @@ class Contract {
   bool gripper_inverted_{false};
 };
 
-/// sha256 of the concatenated lowercase hex hashes, in order (reference §3 `pool_sha256`).
+/// sha256 of the concatenated lowercase hex hashes, in order (`pool_sha256`; docs/reference.md, *Contracts*).
 inline std::string pool_sha256(const std::vector<Contract>& pool) {
   std::string cat;
   cat.reserve(64 * pool.size());

@@ -1,6 +1,6 @@
 #pragma once
 /// \file The stateful decoder: tracked target + lag FIFO per environment, batched over N
-/// environments (reference §1.6). Sized once at construction; step() never allocates.
+/// environments (docs/reference.md, *Contracts*). Sized once at construction; step() never allocates.
 
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/transforms.hpp"

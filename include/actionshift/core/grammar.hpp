@@ -1,5 +1,5 @@
 #pragma once
-/// \file The contract grammar's value grids (DESIGN §3) and a seeded contract sampler.
+/// \file The contract grammar's value grids (docs/semantics.md) and a seeded contract sampler.
 
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/rng.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-/// \file Split manifests and contract pools (DESIGN §7; rules in docs/splits.md).
+/// \file Split manifests and contract pools (rules in docs/splits.md).
 ///
 /// A manifest is a JSON file holding its schema version, generator version, rule, seed, a short
 /// description, optional metadata, the contracts in canonical form (each with its hash and

@@ -1,6 +1,6 @@
 #pragma once
-/// \file The reference's frozen 6-DoF contracts (reference §2.6) and its declared nine-contract
-/// pool (reference §3), so results can be set beside the paper's tables.
+/// \file The reference's frozen 6-DoF contracts (docs/reference.md, *Contracts*) and its declared nine-contract
+/// pool (docs/reference.md, *Contracts*), so results can be set beside the paper's tables.
 
 #include "actionshift/core/contract.hpp"
 

@@ -25,7 +25,7 @@ inline const std::vector<std::string>& generated_split_rules() {
   static const std::vector<std::string> r{"seen", "unseen_value", "unseen_composition", "long_lag", "task_transfer"};
   return r;
 }
-/// The reference's frozen splits (two contracts each, reference §2.6).
+/// The reference's frozen splits (two contracts each; docs/reference.md, *Contracts*).
 inline const std::vector<std::string>& reference_split_rules() {
   static const std::vector<std::string> r{"reference_seen", "reference_unseen_composition", "reference_long_lag"};
   return r;
@@ -204,12 +204,12 @@ inline Manifest generate(const std::string& rule, std::uint64_t seed = kDefaultS
     const std::string which = rule.substr(std::string("reference_").size());
     return Manifest::split(rule, rule, seed,
                            "the reference implementation's two frozen 6-DoF contracts for its '" + which +
-                               "' split (reference §2.6), in its contract-index order",
+                               "' split (docs/reference.md, *Contracts*), in its contract-index order",
                            nlohmann::json::object(), {}, reference::representative_contracts(which));
   }
   if (rule == "reference9")
     return Manifest::pool("reference9", rule, seed,
-                          "the reference's declared nine-contract pool, in its order (reference §3)",
+                          "the reference's declared nine-contract pool, in its order (docs/reference.md, *Contracts*)",
                           nlohmann::json::object(), reference::pool9());
   if (rule == "full") {
     std::vector<Contract> members{Contract::identity()};

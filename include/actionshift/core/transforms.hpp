@@ -1,5 +1,5 @@
 #pragma once
-/// \file Pure decode/encode of one action under a contract (reference §1.3–§1.5, DESIGN §3).
+/// \file Pure decode/encode of one action under a contract (docs/semantics.md §3; docs/reference.md, *Contracts*).
 ///
 /// decode: raw → permutation → sign·scale (indexed by output channel) → frame (tool: rotate the
 /// translation and the rotation vector by R, the live TCP orientation read before the step) →

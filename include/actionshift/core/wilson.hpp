@@ -1,5 +1,5 @@
 #pragma once
-/// \file The Wilson score interval of a binomial proportion (reference §9), shared by Gate 0 (policy
+/// \file The Wilson score interval of a binomial proportion (docs/reference.md, *Statistics*), shared by Gate 0 (policy
 /// layer) and the evaluation statistics (eval layer).
 
 #include <cmath>

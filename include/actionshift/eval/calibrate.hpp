@@ -1,5 +1,5 @@
 #pragma once
-/// \file Response calibration on the unwrapped simulator (reference §4.1): random canonical
+/// \file Response calibration on the unwrapped simulator (docs/reference.md, *Calibration and the response model*): random canonical
 /// actions, the TCP response of each step, and a per-channel linear fit.
 
 #include "actionshift/adapt/calibration.hpp"

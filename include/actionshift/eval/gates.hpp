@@ -1,5 +1,5 @@
 #pragma once
-/// \file Gates computed by code (DESIGN §8; reference §8): Gate 1 (privileged ceiling: oracle vs no adaptation), promotion rules, and the
+/// \file Gates computed by code (docs/reference.md, *Gates*; docs/formats.md §8): Gate 1 (privileged ceiling: oracle vs no adaptation), promotion rules, and the
 /// comparison of verdict files that CI uses to catch regressions.
 
 #include "actionshift/eval/record.hpp"
@@ -35,7 +35,7 @@ bool superiority_allowed(const std::vector<std::uint64_t>& seeds);
 // Gate 0 (backbone competence and wrapper parity) is computed where its rollouts are: policy/gate0.hpp.
 
 // ---------------------------------------------------------------------------------------------
-// Gate 1: privileged ceiling (issue 5; reference §8.2)
+// Gate 1: privileged ceiling (issue 5; docs/reference.md, *Gates*)
 
 /// Gate 1 passes a cell when the oracle reaches this success rate (point estimate)…
 inline constexpr double kGate1OracleMin = 0.95;
@@ -78,7 +78,7 @@ nlohmann::json gate1_to_json(const Gate1Report& report);
 std::string gate1_to_markdown(const Gate1Report& report);
 
 // ---------------------------------------------------------------------------------------------
-// Promotion (issue 6; DESIGN §8; reference §8.3)
+// Promotion (issue 6; docs/reference.md, *Gates*)
 
 /// Minimum paired gain in success_once over the matched baseline (5 percentage points).
 inline constexpr double kPromotionMinGain = 0.05;

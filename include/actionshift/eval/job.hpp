@@ -1,5 +1,5 @@
 #pragma once
-/// \file Job specifications and their content-hash ids (DESIGN §8, docs/formats.md "Job spec").
+/// \file Job specifications and their content-hash ids (docs/formats.md "Job spec").
 ///
 /// A job is everything that determines an evaluation's episodes: task, split (name, manifest hash and
 /// contract count), method and parameters, backbone and its hash, pool, calibration, rotation mode,
@@ -41,7 +41,7 @@ struct PoolRef {
 };
 
 /// Accepted values of JobSpec::rotation_mode.
-/// "live": tool frame = live TCP orientation (default, DESIGN §3); "identity": R = I (reference v1).
+/// "live": tool frame = live TCP orientation (default, docs/semantics.md §4); "identity": R = I (the reference implementation's headline setting).
 inline constexpr std::string_view kRotationModes[] = {"live", "identity"};
 
 /// Accepted values of JobSpec::profile: the simulator fidelity profiles (sim::profile_names()).

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Statistics for evaluation results: Wilson score intervals, percentile bootstrap, paired
-/// success differences and a two-proportion summary (reference §9, Appendix A.3).
+/// success differences and a two-proportion summary (docs/reference.md, *Statistics*).
 
 #include "actionshift/core/wilson.hpp"
 
@@ -14,7 +14,7 @@
 namespace actionshift::eval {
 
 using actionshift::kZ95;
-/// Default number of bootstrap resamples (DESIGN §8).
+/// Default number of bootstrap resamples (docs/reference.md, *Gates*).
 inline constexpr std::size_t kBootstrapSamples = 10000;
 /// Default bootstrap seed (the reference's experimental seed, §7.6).
 inline constexpr std::uint64_t kBootstrapSeed = 20260718;

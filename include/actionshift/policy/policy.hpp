@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// The frozen-policy interface (DESIGN section 5): a `Policy` maps a task's flat state observation to
-/// a canonical action (DESIGN section 3: 7 numbers, +-1 = +-0.1 m / +-0.1 rad per 0.05 s control step,
+/// The frozen-policy interface (docs/backbones.md): a `Policy` maps a task's flat state observation to
+/// a canonical action (docs/semantics.md §1: 7 numbers, +-1 = +-0.1 m / +-0.1 rad per 0.05 s control step,
 /// robot base frame, gripper +1 open / -1 closed). Policies are per-episode state objects: `reset()`
 /// at episode start, then `act()` once per control step; `clone()` gives an independent copy for
 /// another worker thread.

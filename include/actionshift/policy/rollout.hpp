@@ -3,7 +3,7 @@
 /// Running a policy for whole episodes, unwrapped (sim::Env) or behind a hidden contract
 /// (sim::HiddenContractEnv with the identity or any other contract applied to the policy's actions),
 /// on all cores with one environment and one policy clone per worker thread. Episode k starts from
-/// the env seed `derive_seed({seed, contract_index, k})` (DESIGN section 4), so results do not depend
+/// the env seed `derive_seed({seed, contract_index, k})` (docs/sim.md §9), so results do not depend
 /// on the number of threads, and the unwrapped and wrapped runs see the same initial states.
 
 #include "actionshift/core/contract.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-/// \file The self-test's named wirings (reference §11): the default library pool of plausible
+/// \file The self-test's named wirings (docs/reference.md, *Self-test*): the default library pool of plausible
 /// miswirings, and the synthetic demos (the library minus `relabeled`, plus the deliberately
 /// out-of-pool `unmodeled`).
 
@@ -33,7 +33,7 @@ std::optional<Contract> named_contract(std::string_view name);
 /// The names accepted by named_contract(), comma-separated (for error messages).
 std::string named_contract_list();
 
-/// `pool` with `expected` appended unless an equal contract is already in it (reference §11: the
+/// `pool` with `expected` appended unless an equal contract is already in it (docs/reference.md, *Self-test*: the
 /// hidden truth is never added).
 std::vector<Contract> with_expected(std::vector<Contract> pool, const Contract& expected);
 

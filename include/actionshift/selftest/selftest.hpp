@@ -1,5 +1,5 @@
 #pragma once
-/// \file Plug-and-verify self-test with the control loop inverted (DESIGN §1, reference §11): the
+/// \file Plug-and-verify self-test with the control loop inverted (docs/selftest.md; docs/reference.md, *Self-test*): the
 /// caller's controller owns the robot. It asks for the next bounded probe, sends it, feeds back the
 /// measured TCP pose, and after the budget asks for the verdict. Depends on core and the pool belief
 /// only (no simulator).
@@ -35,7 +35,7 @@ namespace actionshift::selftest {
 
 enum class Strategy {
   kFixed,    ///< +amplitude on channels 0..5 in turn, then −amplitude, ... (reference `fixed_probe_pulse`)
-  kEntropy,  ///< greedy one-step minimum expected posterior entropy over the 12 axis pulses (reference §5.2,
+  kEntropy,  ///< greedy one-step minimum expected posterior entropy over the 12 axis pulses (docs/reference.md, *Probes*,
              ///< calibrated and lag-aware preview), return-balanced unless Options::return_balanced is false
 };
 const char* to_string(Strategy s);  ///< "fixed" or "entropy"
@@ -53,7 +53,7 @@ struct TcpPose {
   std::optional<Eigen::Vector2d> fingers;               ///< optional finger joint positions [m]
 };
 
-/// Self-test settings (reference §11 defaults). Validated by validate(), by create() and by the
+/// Self-test settings (defaults: docs/reference.md, *Self-test*). Validated by validate(), by create() and by the
 /// throwing constructor through the same checker.
 struct Options {
   Contract expected;                ///< the wiring the policy assumes (default identity)

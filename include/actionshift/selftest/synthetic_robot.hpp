@@ -1,5 +1,5 @@
 #pragma once
-/// \file The synthetic stand-in robot of the self-test demos (reference §11 "synthetic"): the hidden
+/// \file The synthetic stand-in robot of the self-test demos (docs/reference.md, *Self-test*): the hidden
 /// contract's stateful decoder with R = I, then a TCP that moves by response = α ⊙ canonical[0:6] +
 /// σ·N(0, 1) per step (translation added to the position, rotation vector composed onto the
 /// orientation). Deterministic in its seed; no simulator.

@@ -1,5 +1,5 @@
 #pragma once
-/// \file The self-test's verdict (reference §11 `decide_verdict`), as a pure function of the
+/// \file The self-test's verdict (`decide_verdict`; docs/reference.md, *Self-test*), as a pure function of the
 /// identification evidence, plus its text and JSON renderings.
 ///
 /// Rules, in order (floor = confidence floor, ratio = misspecification ratio):
@@ -101,9 +101,9 @@ struct ReportHeader {
   int pool_size{0};                  ///< declared pool size
 };
 
-/// The human report (reference §11 text layout).
+/// The human report (the reference implementation's text layout).
 std::string to_text(const Verdict& v, const ReportHeader& h);
-/// The machine report: one JSON object, indent 2, sorted keys (reference §11 keys plus ours).
+/// The machine report: one JSON object, indent 2, sorted keys (the reference implementation's keys plus ours).
 std::string to_json(const Verdict& v, const ReportHeader& h);
 
 }  // namespace actionshift::selftest

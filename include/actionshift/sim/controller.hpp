@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The `pd_ee_delta_pose` arm controller (DESIGN section 3): canonical pose delta -> TCP target pose
+/// The `pd_ee_delta_pose` arm controller (docs/semantics.md §1, docs/sim.md §4): canonical pose delta -> TCP target pose
 /// -> damped-least-squares IK -> joint position targets for the PD drives.
 
 #include "actionshift/sim/kinematics.hpp"

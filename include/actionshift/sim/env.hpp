@@ -1,13 +1,13 @@
 #pragma once
 /// \file
 /// The Bullet Panda environment: an immutable, thread-shareable EnvModel (robot, task, settings)
-/// and a per-worker Env (Bullet world, episode state, RNG) - the model/data split of STYLE 2.3.
+/// and a per-worker Env (Bullet world, episode state, RNG) - the model/data split (immutable model, mutable per-episode data).
 ///
 /// \code
 ///   auto model = actionshift::sim::EnvModel::make(actionshift::sim::TaskId::kPickCube);
 ///   actionshift::sim::Env env(model);              // one per thread
 ///   Eigen::VectorXd obs = env.reset(seed);          // initial state = pure function of seed
-///   const auto& r = env.step(canonical_action);     // 7 numbers, DESIGN section 3
+///   const auto& r = env.step(canonical_action);     // 7 numbers, docs/semantics.md §1
 /// \endcode
 
 #include "actionshift/core/types.hpp"
@@ -33,7 +33,7 @@ struct ModelData;
 struct EnvImpl;
 }  // namespace detail
 
-/// Why an episode was ended early (fail closed, DESIGN section 4). kNone = not ended by safety.
+/// Why an episode was ended early (fail closed, docs/sim.md §7). kNone = not ended by safety.
 enum class SafetyFlag : std::uint8_t {
   kNone = 0,             ///< "none"
   kBadActionShape,       ///< "bad_action_shape": the action does not have 7 entries

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The hidden-contract environment (DESIGN sections 3, 6): raw action -> core Decoder (frame rotation
+/// The hidden-contract environment (docs/semantics.md, docs/sim.md §8): raw action -> core Decoder (frame rotation
 /// = live TCP orientation, or identity) -> pd_ee_delta_pose controller. The agent-facing type has
 /// no way to reach the contract; the evaluation-only OracleRecorder, built by the runner from the
 /// same env, reads it.

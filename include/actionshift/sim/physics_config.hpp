@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Simulation settings of the Bullet Panda (DESIGN section 4; docs/sim.md explains every default).
+/// Simulation settings of the Bullet Panda (docs/sim.md explains every default).
 
 #include <cmath>
 
@@ -18,7 +18,7 @@ enum class ArmDrive {
 };
 
 /// Physics and drive settings. Defaults reproduce ManiSkill's `panda` + pd_ee_delta_pose intent
-/// with the Bullet settings that make a grasp hold (dependency notes section 3).
+/// with the Bullet settings that make a grasp hold (docs/reference.md, "Bullet settings"; docs/sim.md §2).
 struct PhysicsConfig {
   double control_dt_s{0.05};          ///< one control step (20 Hz)
   int sim_steps_per_control{5};       ///< 100 Hz simulation steps per control step
