@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include "actionshift/sim/bench.hpp"
+#include "actionshift/sim/robot_source.hpp"
 
 #include <cstdio>
 #include <thread>
@@ -15,8 +16,14 @@ int run_bench_env(const BenchEnvOptions& o) {
     std::fprintf(stderr, "actionshift: error: --steps: must be >= 1 (got %lld)\n", o.steps);
     return kBadInput;
   }
-  const sim::EnvThroughput one = sim::measure_env_throughput(task, o.steps, 1, 1, o.profile);
-  const sim::EnvThroughput all = sim::measure_env_throughput(task, o.steps, threads, 1, o.profile);
+  if (o.robot.urdf.empty() && !o.robot.packages.empty()) {
+    std::fprintf(stderr, "actionshift: error: --package: %s: needs --robot URDF\n", o.robot.packages.front().c_str());
+    return kBadInput;
+  }
+  std::shared_ptr<const sim::RobotDescription> robot;
+  if (!o.robot.urdf.empty()) robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
+  const sim::EnvThroughput one = sim::measure_env_throughput(task, o.steps, 1, 1, robot, o.profile);
+  const sim::EnvThroughput all = sim::measure_env_throughput(task, o.steps, threads, 1, robot, o.profile);
   if (o.json) {
     std::printf("{\"task\":\"%s\",\"profile\":\"%s\",\"threads\":%d,\"steps_per_s_one_thread\":%.1f,\"steps_per_s_all_threads\":%.1f}\n",
                 std::string(sim::task_name(task)).c_str(), o.profile.c_str(), threads, one.steps_per_s, all.steps_per_s);

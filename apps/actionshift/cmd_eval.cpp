@@ -4,11 +4,16 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/eval/gates.hpp"
+#include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/store.hpp"
 #include "actionshift/eval/summary.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -64,6 +69,14 @@ eval::RunResult run_with(const eval::JobSpec& job, const RunPlanOptions& o, cons
       << (r.already_complete ? "already complete" : std::to_string(r.episodes_run) + " episodes run") << ", "
       << r.episodes_total << " in " << r.jsonl_path << "\n";
   return r;
+}
+
+// the overall position in a plan, one line on stderr before each job (not with --progress off)
+void announce(const eval::PlannedJob& pj, std::size_t total, const RunPlanOptions& o, std::ostream& err) {
+  if (o.progress == "off") return;
+  err << "actionshift: job " << pj.index + 1 << "/" << total << ": " << pj.job_id.substr(0, 12) << " " << pj.spec.task
+      << "/" << pj.spec.split.name << "/" << pj.spec.method << " seed " << pj.spec.seed << "\n";
+  err.flush();
 }
 
 }  // namespace
@@ -166,37 +179,108 @@ int run_gate_check(const GateCheckOptions& o, std::ostream& out, std::ostream& e
   });
 }
 
+std::string resolve_executable(const std::string& executable) {
+  std::error_code ec;
+  fs::path p;
+  if (executable.empty()) {
+    p = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) throw InputError("/proc/self/exe", "--executable", "cannot find this binary's path; give --executable");
+  } else if (executable.find('/') != std::string::npos) {
+    p = fs::absolute(executable, ec);
+  } else {
+    const char* path_env = std::getenv("PATH");
+    std::string dirs = path_env ? path_env : "";
+    std::size_t pos = 0;
+    while (p.empty() && pos <= dirs.size()) {
+      auto colon = dirs.find(':', pos);
+      if (colon == std::string::npos) colon = dirs.size();
+      const fs::path cand = fs::path(dirs.substr(pos, colon - pos)) / executable;
+      if (colon > pos && fs::is_regular_file(cand, ec) && ::access(cand.c_str(), X_OK) == 0) p = fs::absolute(cand, ec);
+      pos = colon + 1;
+    }
+    if (p.empty()) throw InputError(executable, "--executable", "not found on PATH; give a path");
+  }
+  p = p.lexically_normal();
+  if (!fs::is_regular_file(p, ec) || ::access(p.c_str(), X_OK) != 0)
+    throw InputError(p.string(), "--executable", "not an executable file");
+  return p.string();
+}
+
+unsigned cluster_max_array_size() {
+  FILE* pipe = ::popen("command -v scontrol >/dev/null 2>&1 && timeout 20 scontrol show config 2>/dev/null", "r");
+  if (!pipe) return eval::kDefaultMaxArraySize;
+  std::string text;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) text.append(buf, n);
+  const int rc = ::pclose(pipe);
+  if (rc != 0) return eval::kDefaultMaxArraySize;
+  return eval::parse_max_array_size(text).value_or(eval::kDefaultMaxArraySize);
+}
+
 int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
     const eval::Experiment ex = eval::load_experiment(o.experiment_file);
-    const eval::Plan plan = eval::make_plan(ex, resolver);
+    eval::Plan plan = eval::make_plan(ex, resolver);
+    if (o.policy_files && !ex.backbone.starts_with("external:"))
+      throw InputError(o.experiment_file, "backbone", "--policy-files needs an external:<command> backbone (got \"" +
+                                                          ex.backbone + "\")");
+    if (o.robot || o.policy_files)
+      for (auto& pj : plan.jobs) {
+        if (o.robot) pj.spec.robot = o.robot;
+        if (o.policy_files) pj.spec.policy_files = o.policy_files;
+        pj.job_id = eval::job_id(pj.spec);
+      }
     const std::string plan_path =
         o.plan_file.empty() ? (fs::path(o.out_dir) / (ex.name + ".plan.json")).string() : o.plan_file;
     ensure_parent(plan_path);
     eval::write_plan(plan_path, plan);
     out << "plan " << ex.name << ": " << plan.jobs.size() << " jobs -> " << plan_path << "\n";
     if (o.slurm) {
+      if (!eval::valid_slurm_time(o.time_limit))
+        throw InputError("--time", o.time_limit,
+                         "not a Slurm time (M, M:S, H:M:S, D-H, D-H:M, D-H:M:S or UNLIMITED, not zero)");
+      if (!o.mem.empty() && !eval::valid_slurm_mem(o.mem))
+        throw InputError("--mem", o.mem, "not a Slurm memory size (a positive integer with an optional K, M, G or T)");
+      if (o.cpus_per_task == 0) throw InputError("--cpus-per-task", "0", "must be at least 1");
       std::error_code ec;
       fs::create_directories(o.out_dir, ec);  // Slurm does not create the --output directory
       if (ec) throw InputError(o.out_dir, "", "cannot create directory: " + ec.message());
       eval::SlurmOptions so;
-      so.plan_path = fs::absolute(plan_path).string();
-      so.out_dir = fs::absolute(o.out_dir).string();
-      so.executable = o.executable;
+      so.plan_path = fs::absolute(plan_path).lexically_normal().string();
+      so.out_dir = fs::absolute(o.out_dir).lexically_normal().string();
+      so.executable = resolve_executable(o.executable);
       so.cpus_per_task = o.cpus_per_task;
       so.time_limit = o.time_limit;
+      so.mem = o.mem;
       so.partition = o.partition;
       so.max_parallel = o.max_parallel;
+      so.max_array_size = o.max_array_size ? o.max_array_size : cluster_max_array_size();
       const std::string script_path =
           o.slurm_file.empty() ? (fs::path(o.out_dir) / (ex.name + ".sbatch")).string() : o.slurm_file;
+      so.script_path = fs::absolute(script_path).lexically_normal().string();
+      std::string stem = so.script_path;
+      if (fs::path(stem).extension() == ".sbatch") stem = stem.substr(0, stem.size() - 7);
+      so.merge_script_path = stem + ".merge.sbatch";
+      const std::string submit_path = stem + ".submit.sh";
       ensure_parent(script_path);
-      {
-        std::ofstream f(script_path, std::ios::binary | std::ios::trunc);
-        f << eval::slurm_array_script(plan, so);
-        if (!f) throw InputError(script_path, "", "cannot write Slurm script");
-      }
-      fs::permissions(script_path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add, ec);
-      out << "slurm array script: " << script_path << " (sbatch " << script_path << ")\n";
+      const auto write_script = [](const std::string& path, const std::string& text) {
+        {
+          std::ofstream f(path, std::ios::binary | std::ios::trunc);
+          f << text;
+          if (!f) throw InputError(path, "", "cannot write Slurm script");
+        }
+        std::error_code pe;
+        fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add, pe);
+      };
+      write_script(so.script_path, eval::slurm_array_script(plan, so));
+      write_script(so.merge_script_path, eval::slurm_merge_script(plan, so));
+      write_script(submit_path, eval::slurm_submit_script(plan, so));
+      const auto chunks = eval::slurm_chunks(static_cast<std::int64_t>(plan.jobs.size()), so.max_array_size);
+      out << "slurm array script: " << so.script_path << " (" << chunks.size()
+          << (chunks.size() == 1 ? " array" : " arrays") << " under MaxArraySize " << so.max_array_size << ")\n"
+          << "slurm merge script: " << so.merge_script_path << " (summarize, gates; after every array task succeeded)\n"
+          << "submit everything:  bash " << submit_path << "\n";
     }
     return kOk;
   });
@@ -210,10 +294,15 @@ int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::os
         throw InputError(o.plan_file, "--job-index",
                          "out of range (plan has " + std::to_string(plan.jobs.size()) + " jobs, got " +
                              std::to_string(*o.job_index) + ")");
-      run_with(plan.jobs[static_cast<std::size_t>(*o.job_index)].spec, o, make, out, err);
+      const auto& pj = plan.jobs[static_cast<std::size_t>(*o.job_index)];
+      announce(pj, plan.jobs.size(), o, err);
+      run_with(pj.spec, o, make, out, err);
       return kOk;
     }
-    for (const auto& pj : plan.jobs) run_with(pj.spec, o, make, out, err);
+    for (const auto& pj : plan.jobs) {
+      announce(pj, plan.jobs.size(), o, err);
+      run_with(pj.spec, o, make, out, err);
+    }
     return kOk;
   });
 }

@@ -68,12 +68,21 @@ struct PlanOptions {
   std::string plan_file;                // --plan FILE ("" → <out>/<experiment>.plan.json)
   bool slurm{false};                    // --slurm
   std::string slurm_file;               // --slurm-script FILE ("" → <out>/<experiment>.sbatch)
-  std::string executable{"actionshift"};  // --executable PATH (the CLI the array tasks call)
+  std::string executable;               // --executable PATH ("" → this binary, /proc/self/exe); made absolute
   unsigned cpus_per_task{2};            // --cpus-per-task N
-  std::string time_limit{"02:00:00"};   // --time
+  std::string time_limit{"02:00:00"};   // --time (Slurm time format, validated)
+  std::string mem;                      // --mem (Slurm memory, e.g. 4G; "" → not set)
   std::string partition;                // --partition
   unsigned max_parallel{0};             // --max-parallel N (array throttle)
+  unsigned max_array_size{0};           // --max-array-size N (0 → `scontrol show config`, else 1001)
+  std::optional<eval::RobotRef> robot;  // set by the caller from --robot/--package: every job runs with it
+  std::optional<eval::PolicyFilesRef> policy_files;  // set by the caller from --policy-files: every job names them
 };
+// The absolute path of `executable` ("" → the running binary): a name without '/' is looked up on
+// PATH. Throws InputError when it is not an executable file.
+std::string resolve_executable(const std::string& executable);
+// MaxArraySize from `scontrol show config` when scontrol runs, else eval::kDefaultMaxArraySize.
+unsigned cluster_max_array_size();
 int run_plan(const PlanOptions& options, const eval::PlanResolver& resolver, std::ostream& out = std::cout,
              std::ostream& err = std::cerr);
 

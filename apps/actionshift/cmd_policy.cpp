@@ -1,11 +1,16 @@
 // `train bc` and `gate0`: thin wrappers over the policy layer
 #include "cmd_policy.hpp"
 
+#include "cmd_eval.hpp"
+
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/policy/gate0.hpp"
 #include "actionshift/policy/registry.hpp"
 #include "actionshift/policy/train.hpp"
+#include "actionshift/sim/robot_source.hpp"
+
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -57,7 +62,9 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     err << "train bc: " << o.task << " " << backbone << ", layers " << sim::observation_layout(t.task).size() +
                                                                             (o.delay_aware ? 28 : 0)
         << "-256-256-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
+    if (o.progress != "off") (void)parse_progress_mode(o.progress);  // validates the mode
     auto result = policy::train_bc(t, [&err, &o](const policy::TrainIteration& it) {
+      if (o.progress == "off") return;
       err << "  iteration " << it.iteration + 1 << "/" << o.iterations << ": beta " << fmt(it.beta, 3) << ", rollouts "
           << it.successes << "/" << it.episodes << " success, data " << it.samples << ", loss " << fmt(it.loss, 5)
           << ", " << fmt(it.seconds, 1) << " s\n";
@@ -102,6 +109,10 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
     reg.backbones_dir = o.backbones_dir;
     reg.external.step_timeout_s = o.step_timeout_s;
     pol = policy::make_policy(o.backbone, task, reg);
+    if (!o.robot.urdf.empty() || !o.robot.packages.empty()) {
+      if (o.robot.urdf.empty()) throw InputError("--package", o.robot.packages.front(), "needs --robot URDF");
+      run.robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
+    }
   } catch (const std::invalid_argument& e) {
     err << "actionshift: error: " << e.what() << "\n";
     return 2;
@@ -109,11 +120,24 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
     err << "actionshift: error: " << e.what() << "\n";
     return 2;
   }
-  if (o.progress) {
-    run.progress = [&err, last = std::int64_t{-1}](std::int64_t k, std::int64_t n) mutable {
+  eval::ProgressMode mode;
+  try {
+    mode = parse_progress_mode(o.progress);
+  } catch (const std::invalid_argument& e) {
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  }
+  if (mode == eval::ProgressMode::automatic)
+    mode = ::isatty(STDERR_FILENO) ? eval::ProgressMode::bar : eval::ProgressMode::lines;
+  const bool bar = mode == eval::ProgressMode::bar;
+  const bool progress = mode != eval::ProgressMode::off;
+  if (progress) {
+    // a bar rewrites one line (a terminal only); lines mode prints a line per 10 %, never a carriage return
+    run.progress = [&err, bar, last = std::int64_t{-1}](std::int64_t k, std::int64_t n) mutable {
       const std::int64_t pct = 100 * k / n;
       if (pct / 10 != last / 10 || k == n) {
-        err << "\rgate0: " << k << "/" << n << " episodes (" << pct << " %)" << (k == n ? "\n" : "") << std::flush;
+        if (bar) err << "\rgate0: " << k << "/" << n << " episodes (" << pct << " %)" << (k == n ? "\n" : "") << std::flush;
+        else err << "gate0: " << k << "/" << n << " episodes (" << pct << " %)\n" << std::flush;
         last = pct;
       }
     };
@@ -122,7 +146,7 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
   try {
     v = policy::run_gate0(*pol, run);
   } catch (const std::exception& e) {
-    if (o.progress) err << "\n";
+    if (bar) err << "\n";
     err << "actionshift: error: " << e.what() << "\n";
     return 2;
   }

@@ -2,6 +2,8 @@
 // Policy subcommands of the actionshift CLI as plain functions (no CLI11 here): main.cpp maps parsed
 // options onto these structs. Each returns 0 ok, 1 check failed (Gate 0 "exclude"), 2 bad input.
 
+#include "commands.hpp"
+
 #include <cstdint>
 #include <iostream>
 #include <string>
@@ -20,6 +22,7 @@ struct TrainBcOptions {
   int steps{1500};                  // --steps Adam steps per iteration
   unsigned threads{0};              // --threads for data collection (0: all cores)
   std::string out;                  // --out FILE ("" → configs/backbones/<task>.mlp[-delay-aware].asmlp)
+  std::string progress{"auto"};     // --progress auto|bar|lines|off: one line per iteration unless off
 };
 int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
@@ -38,7 +41,8 @@ struct Gate0Options {
   std::string out;                  // --out FILE: write the verdict file
   std::string backbones_dir;        // --backbones-dir ("" → default)
   double step_timeout_s{10.0};      // --step-timeout (external policies)
-  bool progress{true};              // progress on stderr (off with --quiet)
+  std::string progress{"auto"};     // --progress auto|bar|lines|off (as `run`; --quiet = off)
+  RobotOptions robot;               // --robot/--package
 };
 int run_gate0(const Gate0Options& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

@@ -15,13 +15,47 @@
 
 namespace actionshift::cli {
 
+std::optional<sim::RobotSource> load_cli_robot(const RobotOptions& o) {
+  if (o.urdf.empty()) {
+    if (!o.packages.empty()) throw InputError("--package", o.packages.front(), "needs --robot URDF");
+    return std::nullopt;
+  }
+  return sim::load_robot_source(o.urdf, sim::parse_package_args(o.packages));
+}
+
+std::optional<eval::RobotRef> cli_robot_ref(const RobotOptions& o) {
+  const auto r = load_cli_robot(o);
+  if (!r) return std::nullopt;
+  return eval::RobotRef{r->sha256, r->urdf, r->packages};
+}
+
+std::optional<eval::PolicyFilesRef> cli_policy_files(const std::vector<std::string>& files, const std::string& backbone) {
+  if (files.empty()) return std::nullopt;
+  if (!backbone.starts_with("external:"))
+    throw InputError("--policy-files", files.front(), "only applies to an external:<command> backbone (got \"" + backbone + "\")");
+  eval::PolicyFilesRef ref;
+  ref.sha256 = eval::files_content_sha256(files);
+  std::error_code ec;
+  for (const auto& f : files) ref.paths.push_back(std::filesystem::absolute(f, ec).lexically_normal().string());
+  return ref;
+}
+
 int run_run(const RunCliOptions& o) {
   const EpisodeFnFactory factory = [](const eval::JobSpec& job) { return eval::make_episode_fn(job); };
-  if (!o.run.plan_file.empty()) return run_plan_jobs(o.run, factory);
+  if (!o.run.plan_file.empty()) {
+    if (!o.robot.urdf.empty() || !o.robot.packages.empty() || !o.policy_files.empty()) {
+      std::cerr << "actionshift: error: --plan: " << o.run.plan_file
+                << ": a plan's jobs carry their robot and policy files; give --robot/--policy-files to `actionshift plan`\n";
+      return kBadInput;
+    }
+    return run_plan_jobs(o.run, factory);
+  }
   try {
     eval::JobRequest q = o.request;
     q.method.params = o.method_params;
-    const eval::JobSpec job = eval::resolve_job(q, eval::default_resolver());
+    eval::JobSpec job = eval::resolve_job(q, eval::default_resolver());
+    job.robot = cli_robot_ref(o.robot);
+    job.policy_files = cli_policy_files(o.policy_files, job.backbone.name);
     return run_one_job(job, o.run, factory);
   } catch (const std::exception& e) {
     std::cerr << "actionshift: error: " << e.what() << "\n";
@@ -29,7 +63,17 @@ int run_run(const RunCliOptions& o) {
   }
 }
 
-int run_plan_cli(const PlanOptions& o) { return run_plan(o, eval::default_resolver()); }
+int run_plan_cli(const PlanOptions& o, const RobotOptions& robot, const std::vector<std::string>& policy_files) {
+  try {
+    PlanOptions with_robot = o;
+    with_robot.robot = cli_robot_ref(robot);
+    if (!policy_files.empty()) with_robot.policy_files = cli_policy_files(policy_files, "external:");
+    return run_plan(with_robot, eval::default_resolver());
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "actionshift: error: " << e.what() << "\n";
+    return kBadInput;
+  }
+}
 
 int run_calibrate(const CalibrateOptions& o) {
   sim::EnvConfig cfg;
@@ -63,7 +107,8 @@ int run_calibrate(const CalibrateOptions& o) {
     note("joint_limits", o.joint_limits);
   }
   if (!overrides.empty()) cfg.profile += "[" + overrides + "]";
-  const auto model = sim::EnvModel::make(sim::parse_task(o.task), cfg);
+  const auto robot = load_cli_robot(o.robot);
+  const auto model = sim::EnvModel::make(sim::parse_task(o.task), cfg, robot ? robot->description : nullptr);
   eval::CalibrationOptions co;
   try {
     co.protocol = eval::parse_protocol(o.protocol);

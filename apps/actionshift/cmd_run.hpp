@@ -3,6 +3,9 @@
 // eval layer's runner to the real episode function (eval/experiment.hpp). No CLI11 here.
 
 #include "cmd_eval.hpp"
+#include "commands.hpp"
+
+#include "actionshift/sim/robot_source.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -17,11 +20,21 @@ struct RunCliOptions {
   eval::JobRequest request;        // single job (ignored with --plan)
   std::string method_params{"{}"}; // --params: JSON object of method parameters
   RunPlanOptions run;              // plan_file, job_index, out_dir, threads, fsync, progress
+  RobotOptions robot;              // --robot/--package (single job; a plan carries its own)
+  std::vector<std::string> policy_files;  // --policy-files: files of an external policy (content hashed into the id)
 };
 int run_run(const RunCliOptions& o);
 
-// `actionshift plan --experiment FILE ...` with the real resolver.
-int run_plan_cli(const PlanOptions& o);
+// `actionshift plan --experiment FILE ...` with the real resolver; --robot/--package go into every job.
+int run_plan_cli(const PlanOptions& o, const RobotOptions& robot, const std::vector<std::string>& policy_files);
+
+// The PolicyFilesRef of --policy-files (nullopt when none); `backbone` must be external:<command>.
+std::optional<eval::PolicyFilesRef> cli_policy_files(const std::vector<std::string>& files, const std::string& backbone);
+
+// The robot of --robot/--package: nullopt for the embedded Panda. Throws actionshift::InputError.
+std::optional<sim::RobotSource> load_cli_robot(const RobotOptions& o);
+// The same as a job's RobotRef.
+std::optional<eval::RobotRef> cli_robot_ref(const RobotOptions& o);
 
 // `actionshift calibrate --task T [--episodes N] [--steps N] [--seed S] [--out FILE] [--json]`
 struct CalibrateOptions {
@@ -39,6 +52,7 @@ struct CalibrateOptions {
   std::string joint_limits;          // on | off: arm joint limit constraints
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table
+  RobotOptions robot;  // --robot/--package
 };
 int run_calibrate(const CalibrateOptions& o);
 

@@ -8,6 +8,7 @@
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/synthetic_robot.hpp"
+#include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
 #include <nlohmann/json.hpp>
@@ -94,7 +95,9 @@ selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::Observati
 // the episode ended early
 std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o) {
   const sim::TaskId task = sim::parse_task(o.task);
-  auto model = sim::EnvModel::make(task, sim::profile_config(o.profile));
+  std::shared_ptr<const sim::RobotDescription> robot;
+  if (!o.robot.urdf.empty()) robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
+  auto model = sim::EnvModel::make(task, sim::profile_config(o.profile), robot);
   sim::HiddenContractEnv env(model, hidden,
                              o.frame_rotation == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp);
   st.begin(pose_from_obs(env.reset(o.seed), env.layout()));
@@ -120,6 +123,9 @@ int run(const SelftestOptions& o) {
     throw InputError("", "--frame-rotation", "must be live or identity (got '" + o.frame_rotation + "')");
   if (!o.sim && o.frame_rotation != "live") throw InputError("", "--frame-rotation", "only applies with --sim");
   if (!o.sim && !o.calibration.empty()) throw InputError("", "--calibration", "only applies with --sim");
+  if (!o.sim && (!o.robot.urdf.empty() || !o.robot.packages.empty()))
+    throw InputError("", "--robot", "only applies with --sim");
+  if (o.robot.urdf.empty() && !o.robot.packages.empty()) throw InputError("", "--package", "needs --robot URDF");
 
   selftest::Options so;
   so.expected = resolve_contract(o.expected, "--expected");

@@ -3,6 +3,8 @@
 // Exit codes are the self-test's own: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. run_selftest
 // catches its own errors so that bad input is 3, not the CLI's generic 2.
 
+#include "commands.hpp"
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -33,6 +35,7 @@ struct SelftestOptions {
   double misspec_ratio = 4.0;
   std::uint64_t seed = 20260720;
   bool json = false;
+  RobotOptions robot;                        ///< --sim: --robot/--package
 };
 
 /// Runs the self-test and prints the report (text or JSON) on stdout. Returns 0/1/2 by verdict, 3 for

@@ -17,6 +17,13 @@ enum ExitStatus : int {
   kInterrupted = 130,
 };
 
+/// `--robot URDF [--package NAME=DIR]...` of every command that builds an environment: another robot
+/// description than the embedded Panda (loaded by cmd_robot.cpp; its content hash enters job ids).
+struct RobotOptions {
+  std::string urdf;                   ///< --robot FILE ("" → the embedded Panda)
+  std::vector<std::string> packages;  ///< --package NAME=DIR, for package:// URIs
+};
+
 // ---- core (cmd_core.cpp)
 struct ValidateOptions {
   std::vector<std::string> paths;  ///< manifest files or directories; empty: the built-in manifests
@@ -46,6 +53,7 @@ struct BenchEnvOptions {
   long long steps = 12000;         ///< control steps per thread (short runs are dominated by machine noise)
   int threads = 0;                 ///< 0: all hardware threads
   bool json = false;               ///< one JSON object: task, threads, steps_per_s_one_thread, steps_per_s_all_threads
+  RobotOptions robot;              ///< --robot/--package
 };
 int run_bench_env(const BenchEnvOptions& o);
 

@@ -25,6 +25,13 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("actionshift ") + ACTIONSHIFT_VERSION);
   app.footer("Exit codes: 0 ok, 1 a check or gate failed, 2 bad input or usage.");
   std::function<int()> action;
+  // --robot URDF [--package NAME=DIR]... on every command that builds an environment
+  const auto add_robot_options = [](CLI::App* cmd, cli::RobotOptions& r) {
+    cmd->add_option("--robot", r.urdf,
+                    "Robot description (URDF; meshes through assimp) instead of the embedded Panda; its content hash\n"
+                    "(URDF + collision meshes) enters the job id");
+    cmd->add_option("--package", r.packages, "NAME=DIR: resolve package://NAME/... in --robot (repeatable)");
+  };
 
   // ---- validate
   cli::ValidateOptions validate_o;
@@ -84,6 +91,7 @@ int main(int argc, char** argv) {
   bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
       ->capture_default_str();
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
+  add_robot_options(bench_env, bench_env_o.robot);
   bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
 
   // ---- selftest (plug-and-verify; its own exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input)
@@ -117,6 +125,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
   st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
+  add_robot_options(st, st_o.robot);
   st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
 
   // ---- train bc | gate0 (policy layer)
@@ -136,6 +145,8 @@ int main(int argc, char** argv) {
   bc->add_option("--steps", train_o.steps, "Adam steps per iteration")->capture_default_str();
   bc->add_option("--threads", train_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
   bc->add_option("--out", train_o.out, "Weight file (default: configs/backbones/<task>.<backbone>.asmlp)");
+  bc->add_option("--progress", train_o.progress, "auto, bar or lines (one line per iteration) or off, as for run")
+      ->capture_default_str();
   bc->callback([&] { action = [&] { return cli::run_train_bc(train_o); }; });
   cli::Gate0Options gate0_o;
   auto* gate0 = app.add_subcommand(
@@ -155,8 +166,17 @@ int main(int argc, char** argv) {
   gate0->add_option("--out", gate0_o.out, "Write the verdict file here");
   gate0->add_option("--backbones-dir", gate0_o.backbones_dir, "Directory of the MLP weight files");
   gate0->add_option("--step-timeout", gate0_o.step_timeout_s, "Seconds an external policy may take per step")->capture_default_str();
-  gate0->add_flag("--progress,!--quiet", gate0_o.progress, "No progress on stderr");
-  gate0->callback([&] { action = [&] { return cli::run_gate0(gate0_o); }; });
+  gate0->add_option("--progress", gate0_o.progress,
+                    "auto (a bar on a terminal, else lines), bar, lines or off, as for run")->capture_default_str();
+  bool gate0_quiet = false;
+  gate0->add_flag("--quiet", gate0_quiet, "Same as --progress off");
+  add_robot_options(gate0, gate0_o.robot);
+  gate0->callback([&] {
+    action = [&] {
+      if (gate0_quiet) gate0_o.progress = "off";
+      return cli::run_gate0(gate0_o);
+    };
+  });
 
   // ---- run | plan | summarize | gate1 | gate check | calibrate (eval layer)
   cli::RunCliOptions run_o;
@@ -191,6 +211,10 @@ int main(int argc, char** argv) {
   run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores)")->capture_default_str();
   run->add_flag("--fsync", run_o.run.fsync, "fsync after every record");
   run->add_option("--progress", run_o.run.progress, "auto, bar, lines or off")->capture_default_str();
+  add_robot_options(run, run_o.robot);
+  run->add_option("--policy-files", run_o.policy_files,
+                  "Files of an external:<command> backbone (script, weights, config): their content hash enters the\n"
+                  "job id, so editing the policy makes a new job instead of reusing old results");
   run->callback([&] {
     action = [&] {
       if (run_job_index >= 0) run_o.run.job_index = run_job_index;
@@ -205,19 +229,33 @@ int main(int argc, char** argv) {
 
   cli::PlanOptions plan_o;
   auto* plan = app.add_subcommand(
-      "plan", "Expand an experiment (configs/experiments/<name>.yaml) into its job list; --slurm also writes an\n"
-              "sbatch array script with one array task per job (each runs `actionshift run --plan ... --job-index`).");
+      "plan", "Expand an experiment (configs/experiments/<name>.yaml) into its job list. --slurm also writes, beside\n"
+              "the plan, <name>.sbatch (one array task per job: `actionshift run --plan ... --job-index`), <name>.merge.sbatch\n"
+              "(summarize, and gate1 when the plan has oracle and no_adapt) and <name>.submit.sh, which submits the arrays in\n"
+              "chunks under the cluster's MaxArraySize and the merge job with --dependency=afterok. Every path in them is\n"
+              "absolute, so `bash <name>.submit.sh` works from any directory.");
   plan->add_option("--experiment", plan_o.experiment_file, "Experiment YAML")->required();
   plan->add_option("--out", plan_o.out_dir, "Results directory of the jobs")->capture_default_str();
   plan->add_option("--plan", plan_o.plan_file, "Plan file (default <out>/<experiment>.plan.json)");
   plan->add_flag("--slurm", plan_o.slurm, "Also write a Slurm array script");
   plan->add_option("--slurm-script", plan_o.slurm_file, "Script path (default <out>/<experiment>.sbatch)");
-  plan->add_option("--executable", plan_o.executable, "The actionshift binary the array tasks call")->capture_default_str();
-  plan->add_option("--cpus-per-task", plan_o.cpus_per_task, "Slurm --cpus-per-task")->capture_default_str();
-  plan->add_option("--time", plan_o.time_limit, "Slurm --time")->capture_default_str();
+  plan->add_option("--executable", plan_o.executable,
+                   "The actionshift binary the array tasks call (default: this binary; a bare name is looked up on PATH;\n"
+                   "written as an absolute path)");
+  plan->add_option("--cpus-per-task", plan_o.cpus_per_task, "Slurm --cpus-per-task (also the tasks' --threads)")->capture_default_str();
+  plan->add_option("--time", plan_o.time_limit, "Slurm --time per array task: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S or UNLIMITED")
+      ->capture_default_str();
+  plan->add_option("--mem", plan_o.mem, "Slurm --mem per array task, e.g. 4G (default: the cluster's)");
   plan->add_option("--partition", plan_o.partition, "Slurm --partition");
   plan->add_option("--max-parallel", plan_o.max_parallel, "Array throttle (%N)");
-  plan->callback([&] { action = [&] { return cli::run_plan_cli(plan_o); }; });
+  plan->add_option("--max-array-size", plan_o.max_array_size,
+                   "Tasks per array (default: MaxArraySize from `scontrol show config`, else Slurm's default 1001)");
+  cli::RobotOptions plan_robot;
+  add_robot_options(plan, plan_robot);
+  std::vector<std::string> plan_policy_files;
+  plan->add_option("--policy-files", plan_policy_files,
+                   "Files of an external:<command> backbone (script, weights); their content hash enters every job id");
+  plan->callback([&] { action = [&] { return cli::run_plan_cli(plan_o, plan_robot, plan_policy_files); }; });
 
   cli::SummarizeOptions sum_o;
   auto* summarize = app.add_subcommand("summarize", "Merge every <id>.jsonl in a directory into per-cell tables (Markdown or JSON)");
@@ -277,6 +315,7 @@ int main(int argc, char** argv) {
   calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
   calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
+  add_robot_options(calibrate, cal_o.robot);
   calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
 
   try {

@@ -9,6 +9,7 @@
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/policy/registry.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/robot_source.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -155,7 +156,23 @@ EpisodeFn make_episode_fn(const JobSpec& job) {
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
   const sim::TaskId task = sim::parse_task(job.task);
-  ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile));
+  if (job.policy_files) {
+    const std::string now = files_content_sha256(job.policy_files->paths, "policy_files");
+    if (now != job.policy_files->sha256)
+      throw InputError(job.policy_files->paths.front(), "policy_files.sha256",
+                       "the policy files changed since the job was made (their hash is " + now + ", the job's " +
+                           job.policy_files->sha256 + "); make the job again");
+  }
+  if (job.robot) {
+    const sim::RobotSource robot = sim::load_robot_source(job.robot->urdf, job.robot->packages);
+    if (robot.sha256 != job.robot->sha256)
+      throw InputError(job.robot->urdf, "robot.sha256",
+                       "the description (URDF or a mesh) changed since the job was made: its hash is " + robot.sha256 +
+                           ", the job's " + job.robot->sha256);
+    ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile), robot.description);
+  } else {
+    ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile));
+  }
   ctx->slice = tcp_slice(ctx->model->layout());
   ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
 

@@ -148,7 +148,7 @@ Gate1Report gate1(const std::vector<EpisodeRecord>& records, std::size_t samples
       const std::string rates = "oracle " + fixed(c.oracle->rate, 4) + ", no_adapt " + fixed(c.no_adapt->rate, 4);
       if (!gated) {
         c.verdict = "descriptive";
-        c.reason = rates + " (split not gated)";
+        c.reason = rates + " (split '" + c.split + "' is not gated: only seen and unseen_composition are)";
       } else if (c.oracle->rate >= kGate1OracleMin && c.no_adapt->rate <= kGate1NoAdaptMax) {
         c.verdict = "pass";
         c.reason = rates;
@@ -218,7 +218,20 @@ std::string gate1_to_markdown(const Gate1Report& report) {
     s << "| " << c.task << " | " << c.split << " | " << w(c.oracle) << " | " << w(c.no_adapt) << " | " << d << " | "
       << c.seeds.size() << " | " << c.verdict << " |\n";
   }
-  s << "\nclaim status: " << report.claim_status << "; gate 1 " << (report.passed ? "passed" : "not passed") << "\n";
+  bool any_gated = false;
+  for (const auto& c : report.cells) {
+    if (c.verdict == "pass") continue;
+    if (c.verdict != "descriptive") any_gated = true;
+    s << "\n- " << c.task << "/" << c.split << " is "
+      << c.verdict << ": " << c.reason;
+  }
+  for (const auto& c : report.cells) any_gated = any_gated || c.verdict == "pass";
+  bool listed = false;
+  for (const auto& c : report.cells) listed = listed || c.verdict != "pass";
+  if (listed) s << "\n";
+  s << "\nclaim status: " << report.claim_status << "; gate 1 " << (report.passed ? "passed" : "not passed");
+  if (!report.passed && !any_gated) s << " (no gated cell: Gate 1 needs oracle and no_adapt on seen or unseen_composition)";
+  s << "\n";
   return s.str();
 }
 

@@ -7,7 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <climits>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <optional>
 #include <set>
 
@@ -85,6 +89,16 @@ void validate_job(const JobSpec& job, const std::string& src) {
   for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
   if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got \"" + job.profile + "\")");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
+  if (job.policy_files) {
+    check_hash(job.policy_files->sha256, src, "policy_files.sha256");
+    if (job.policy_files->paths.empty()) throw InputError(src, "policy_files.paths", "must name at least one file");
+  }
+  if (job.robot) {
+    check_hash(job.robot->sha256, src, "robot.sha256");
+    if (job.robot->urdf.empty()) throw InputError(src, "robot.urdf", "must not be empty");
+    for (const auto& [name, dir] : job.robot->packages)
+      if (name.empty() || dir.empty()) throw InputError(src, "robot.packages", "names and directories must not be empty");
+  }
 }
 
 nlohmann::json job_to_json(const JobSpec& job) {
@@ -101,14 +115,62 @@ nlohmann::json job_to_json(const JobSpec& job) {
   j["profile"] = job.profile;
   j["seed"] = job.seed;
   j["episodes"] = job.episodes;
+  if (job.robot) {
+    json packages = json::object();
+    for (const auto& [name, dir] : job.robot->packages) packages[name] = dir;
+    j["robot"] = {{"sha256", job.robot->sha256}, {"urdf", job.robot->urdf}, {"packages", packages}};
+  }
+  if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}, {"paths", job.policy_files->paths}};
   return j;
 }
 
-std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_to_json(job)); }
+nlohmann::json job_identity_json(const JobSpec& job) {
+  json j = job_to_json(job);
+  if (job.robot) j["robot"] = {{"sha256", job.robot->sha256}};
+  if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}};
+  return j;
+}
+
+std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_identity_json(job)); }
 
 std::string job_id(const JobSpec& job) { return sha256_hex(job_canonical_json(job)); }
 
 JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
+  if (j.is_object() && j.contains("policy_files")) {  // optional: present only for named policy files
+    json rest = j;
+    rest.erase("policy_files");
+    JobSpec job = job_from_json(rest, src);
+    const json& p = j.at("policy_files");
+    check_keys(p, {"paths", "sha256"}, src, "policy_files");
+    PolicyFilesRef ref;
+    ref.sha256 = str_at(p, "sha256", src, "policy_files.sha256");
+    if (!p.at("paths").is_array()) throw InputError(src, "policy_files.paths", "expected a list of paths");
+    for (const auto& v : p.at("paths")) {
+      if (!v.is_string()) throw InputError(src, "policy_files.paths", "expected a list of paths");
+      ref.paths.push_back(v.get<std::string>());
+    }
+    job.policy_files = std::move(ref);
+    validate_job(job, src);
+    return job;
+  }
+  if (j.is_object() && j.contains("robot")) {  // optional: present only for a user-supplied robot
+    json rest = j;
+    rest.erase("robot");
+    JobSpec job = job_from_json(rest, src);
+    const json& r = j.at("robot");
+    check_keys(r, {"packages", "sha256", "urdf"}, src, "robot");
+    RobotRef ref;
+    ref.sha256 = str_at(r, "sha256", src, "robot.sha256");
+    ref.urdf = str_at(r, "urdf", src, "robot.urdf");
+    if (!r.at("packages").is_object()) throw InputError(src, "robot.packages", "expected an object");
+    for (auto it = r.at("packages").begin(); it != r.at("packages").end(); ++it) {
+      if (!it.value().is_string()) throw InputError(src, "robot.packages." + it.key(), "expected a string");
+      ref.packages[it.key()] = it.value().get<std::string>();
+    }
+    job.robot = std::move(ref);
+    validate_job(job, src);
+    return job;
+  }
   check_keys(j, {"backbone", "calibration_sha256", "episodes", "method", "pool", "profile", "rotation_mode", "schema_version",
                  "seed", "split", "task"},
              src, "");
@@ -151,6 +213,22 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
   job.episodes = static_cast<std::int64_t>(*episodes);
   validate_job(job, src);
   return job;
+}
+
+std::string files_content_sha256(const std::vector<std::string>& paths, const std::string& field) {
+  if (paths.empty()) throw InputError("", field, "name at least one file");
+  std::vector<std::string> hashes;
+  for (const auto& p : paths) {
+    std::ifstream in(p, std::ios::binary);
+    std::error_code ec;
+    if (!in || !std::filesystem::is_regular_file(p, ec)) throw InputError(p, field, "cannot read file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw InputError(p, field, "cannot read file");
+    hashes.push_back(sha256_hex(ss.str()));
+  }
+  std::sort(hashes.begin(), hashes.end());
+  return sha256_hex(canonical_dump(json(hashes)));
 }
 
 std::string jsonl_file_name(std::string_view id) { return std::string(id) + ".jsonl"; }

@@ -21,7 +21,7 @@ const std::set<std::string>& record_keys() {
       "backbone",       "backbone_sha256", "contract_index",     "contract_sha256", "episode_index",
       "job_id",         "method",          "probe_displacement", "probe_steps",     "profile",    "return",
       "safety_flags",   "schema_version",  "seed",               "split",           "steps",
-      "success_at_end", "success_once",    "task"};
+      "success_at_end", "success_once",    "task",               "provenance"};
   return keys;
 }
 
@@ -123,6 +123,9 @@ nlohmann::json to_json(const EpisodeRecord& r) {
   j["backbone"] = r.backbone;
   j["backbone_sha256"] = r.backbone_sha256;
   j["profile"] = r.profile;
+  if (!r.actionshift_version.empty())
+    j["provenance"] = {{"actionshift_version", r.actionshift_version},
+                       {"git_commit", r.git_commit.empty() ? json(nullptr) : json(r.git_commit)}};
   return j;
 }
 
@@ -160,6 +163,15 @@ EpisodeRecord record_from_json(const nlohmann::json& j, const std::string& src) 
   r.backbone = get_string(j, "backbone", src);
   r.backbone_sha256 = get_string(j, "backbone_sha256", src);
   r.profile = get_string(j, "profile", src);
+  if (j.contains("provenance")) {  // optional: absent in records written before it existed
+    const json& p = j.at("provenance");
+    if (!p.is_object() || !p.contains("actionshift_version") || !p.at("actionshift_version").is_string() ||
+        !p.contains("git_commit") || !(p.at("git_commit").is_string() || p.at("git_commit").is_null()) || p.size() != 2)
+      throw InputError(src, "provenance", "expected {\"actionshift_version\": string, \"git_commit\": string or null}" + shown(p));
+    r.actionshift_version = p.at("actionshift_version").get<std::string>();
+    if (r.actionshift_version.empty()) throw InputError(src, "provenance.actionshift_version", "must not be empty");
+    if (p.at("git_commit").is_string()) r.git_commit = p.at("git_commit").get<std::string>();
+  }
   validate_record(r, src);
   return r;
 }

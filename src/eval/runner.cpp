@@ -1,5 +1,7 @@
 #include "actionshift/eval/runner.hpp"
 
+#include "actionshift/core/workers.hpp"
+#include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/store.hpp"
 #include "io.hpp"
 
@@ -109,7 +111,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
     return result;
   }
 
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  unsigned threads = resolve_threads(options.threads);
   const std::int64_t first = store.episodes_done();
   const std::int64_t remaining = job.episodes - first;
   threads = static_cast<unsigned>(std::min<std::int64_t>(threads, remaining));
@@ -150,6 +152,8 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
         r.backbone = job.backbone.name;
         r.backbone_sha256 = job.backbone.sha256;
         r.profile = job.profile;
+        r.actionshift_version = build_provenance().version;
+        r.git_commit = build_provenance().git_commit;
         validate_record(r, "episode " + std::to_string(i));
         std::lock_guard lock(mu);
         ready.emplace(i, std::move(r));
@@ -164,9 +168,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
     }
   };
 
-  std::vector<std::thread> pool;
-  pool.reserve(threads);
-  for (unsigned w = 0; w < threads; ++w) pool.emplace_back(worker, w);
+  WorkerPool pool(threads, worker);
 
   Progress progress(options.progress, log, store.job_id(), first, job.episodes);
   std::exception_ptr write_failure;
@@ -199,7 +201,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
       lock.lock();
     }
   }
-  for (auto& t : pool) t.join();
+  pool.join();  // workers keep their own exceptions (failure); join() never sees one
 
   result.episodes_run = store.episodes_done() - first;
   result.wall_time_s = seconds_since(t0);

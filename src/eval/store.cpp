@@ -1,6 +1,9 @@
 #include "actionshift/eval/store.hpp"
 
+#include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/statistics.hpp"
 #include "io.hpp"
 
@@ -14,6 +17,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <ostream>
 #include <stdexcept>
@@ -133,7 +137,59 @@ ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, co
                    << " bytes removed after record " << records.size() << ")\n";
   }
   s.records_ = std::move(records);
+  if (s.records_.empty() && bytes.empty()) s.adopt_from_sibling(out_dir, options);
   return s;
+}
+
+std::string family_key(const JobSpec& job) {
+  nlohmann::json j = job_identity_json(job);
+  j.erase("episodes");
+  return canonical_dump(j);
+}
+
+void ResultStore::adopt_from_sibling(const std::string& out_dir, const StoreOptions& options) {
+  namespace fs = std::filesystem;
+  const std::string family = family_key(job_);
+  std::error_code ec;
+  std::vector<EpisodeRecord> best;
+  std::string best_id;
+  for (const auto& entry : fs::directory_iterator(out_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const std::string suffix = ".summary.json";
+    if (name.size() != 64 + suffix.size() || !name.ends_with(suffix)) continue;
+    const std::string id = name.substr(0, 64);
+    if (id == id_ || !is_sha256_hex(id)) continue;
+    const fs::path jsonl = fs::path(out_dir) / jsonl_file_name(id);
+    try {
+      std::ifstream in(entry.path(), std::ios::binary);
+      const nlohmann::json summary = nlohmann::json::parse(in);
+      const JobSpec other = job_from_json(summary.at("job"), entry.path().string());
+      if (eval::job_id(other) != id || family_key(other) != family || !fs::exists(jsonl)) continue;
+      RecordFile rf = read_record_file(jsonl.string(), /*allow_torn_tail=*/true);
+      std::vector<EpisodeRecord> prefix;
+      for (auto& r : rf.records) {
+        const auto k = static_cast<std::int64_t>(prefix.size());
+        if (k >= job_.episodes || r.episode_index != k) break;
+        prefix.push_back(std::move(r));
+      }
+      if (prefix.size() > best.size()) {
+        best = std::move(prefix);
+        best_id = id;
+      }
+    } catch (const std::exception&) {
+      continue;  // not a job summary of ours, or a sibling with bad records: never adopt from it
+    }
+  }
+  if (best.empty()) return;
+  for (auto& r : best) {
+    r.job_id = id_;
+    append(r);
+  }
+  adopted_ = static_cast<std::int64_t>(best.size());
+  adopted_from_ = best_id;
+  if (options.log)
+    *options.log << "actionshift: job " << id_.substr(0, 12) << ": copied episodes 0.." << adopted_ - 1 << " from job "
+                 << best_id.substr(0, 12) << " (the same job with a different episode count)\n";
 }
 
 ResultStore::ResultStore(ResultStore&& o) noexcept
@@ -199,6 +255,7 @@ nlohmann::json make_job_summary(const JobSpec& job, const std::vector<EpisodeRec
   s["episodes_run"] = episodes_run;
   s["wall_time_s"] = wall_time_s;
   s["message"] = message;
+  s["provenance"] = provenance_to_json(build_provenance());
 
   std::int64_t once = 0, at_end = 0, flagged = 0, probe_steps = 0, steps = 0;
   double ret = 0.0, disp = 0.0;

@@ -1,12 +1,15 @@
 #include "actionshift/eval/summary.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/eval/store.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -32,11 +35,51 @@ ResultSet load_results(const std::string& dir) {
     if (entry.is_regular_file() && entry.path().extension() == ".jsonl") out.files.push_back(entry.path().string());
   if (ec) throw InputError(dir, "", "cannot list directory: " + ec.message());
   std::sort(out.files.begin(), out.files.end());
+  // Jobs that differ only in their episode count (a grown job and the job it grew from) overlap:
+  // their shared episodes are counted once. The family comes from each job's summary file.
+  struct Seen {
+    std::size_t record;
+    std::string file;
+  };
+  std::map<std::pair<std::string, std::int64_t>, Seen> seen;  // (family, episode index) → first record
+  std::set<std::pair<std::string, std::string>> overlapping;   // (kept file, skipped file)
   for (const auto& f : out.files) {
     RecordFile rf = read_record_file(f, /*allow_torn_tail=*/true);
     if (rf.torn_tail) out.notes.push_back(f + ": ignored an unterminated last line (job running or killed)");
-    for (auto& r : rf.records) out.records.push_back(std::move(r));
+    std::string family;
+    const fs::path summary = fs::path(f).replace_extension(".summary.json");
+    if (fs::exists(summary, ec)) {
+      try {
+        std::ifstream in(summary, std::ios::binary);
+        const JobSpec job = job_from_json(json::parse(in).at("job"), summary.string());
+        if (job_id(job) == fs::path(f).stem().string()) family = family_key(job);
+      } catch (const std::exception&) {
+        family.clear();  // no usable summary: the job's records stand alone
+      }
+    }
+    for (auto& r : rf.records) {
+      if (!family.empty()) {
+        const auto [it, inserted] = seen.emplace(std::make_pair(family, r.episode_index), Seen{out.records.size(), f});
+        if (!inserted) {
+          EpisodeRecord a = out.records[it->second.record], b = r;
+          a.job_id = b.job_id;
+          a.actionshift_version = b.actionshift_version;
+          a.git_commit = b.git_commit;
+          if (!(a == b))
+            throw InputError(dir, fs::path(f).filename().string(),
+                             "overlaps " + fs::path(it->second.file).filename().string() +
+                                 " (the same job with another episode count) but episode " +
+                                 std::to_string(r.episode_index) + " differs between them (built from other code?); remove one");
+          overlapping.emplace(it->second.file, f);
+          continue;
+        }
+      }
+      out.records.push_back(std::move(r));
+    }
   }
+  for (const auto& [kept, skipped] : overlapping)
+    out.notes.push_back(skipped + ": the same job as " + fs::path(kept).filename().string() +
+                        " with another episode count; shared episodes counted once (remove the smaller job to silence this)");
   return out;
 }
 

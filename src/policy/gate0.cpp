@@ -101,7 +101,7 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
 
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   if (run.episodes <= 0) throw std::invalid_argument("at least one episode is required");
-  auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile));
+  auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile), run.robot);
   RolloutOptions o;
   o.seed = run.seed;
   o.contract_index = 0;

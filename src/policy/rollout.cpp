@@ -1,6 +1,8 @@
 // episode loops and the parallel episode runner (one Env and one policy clone per thread)
 #include "actionshift/policy/rollout.hpp"
 
+#include "actionshift/core/workers.hpp"
+
 #include "actionshift/core/rng.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
@@ -44,10 +46,7 @@ EpisodeOutcome run_episode(sim::HiddenContractEnv& env, Policy& policy, std::uin
   return run_loop(env, policy, env_seed, stop_on_success);
 }
 
-unsigned resolve_threads(unsigned requested) {
-  if (requested > 0) return requested;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
+unsigned resolve_threads(unsigned requested) { return actionshift::resolve_threads(requested); }
 
 std::vector<EpisodeOutcome> run_episodes(const Policy& policy, std::shared_ptr<const sim::EnvModel> model,
                                          const RolloutOptions& o) {
@@ -85,10 +84,7 @@ std::vector<EpisodeOutcome> run_episodes(const Policy& policy, std::shared_ptr<c
       failed.store(true);
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  run_workers(threads, [&](unsigned) { worker(); });
   if (error) std::rethrow_exception(error);
   return results;
 }

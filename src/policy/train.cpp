@@ -1,6 +1,8 @@
 // DAgger behaviour cloning of the MLP backbone from the scripted experts (Eigen, Adam)
 #include "actionshift/policy/train.hpp"
 
+#include "actionshift/core/workers.hpp"
+
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/rng.hpp"
 #include "actionshift/policy/delay_aware.hpp"
@@ -170,10 +172,7 @@ TrainBcResult train_bc(const TrainBcOptions& o, const std::function<void(const T
         if (!error) error = std::current_exception();
       }
     };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+    run_workers(threads, [&](unsigned) { worker(); });
     if (error) std::rethrow_exception(error);
 
     // normalisation from the expert's data (iteration 0), fixed afterwards

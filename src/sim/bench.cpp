@@ -1,6 +1,8 @@
 // env throughput: scripted contact-rich episodes on one or more threads
 #include "actionshift/sim/bench.hpp"
 
+#include "actionshift/core/workers.hpp"
+
 #include "actionshift/core/rng.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/grasp_script.hpp"
@@ -31,19 +33,18 @@ long long run_episodes(const std::shared_ptr<const EnvModel>& model, long long s
 }  // namespace
 
 EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, int threads, std::uint64_t seed,
-                                     std::string_view profile) {
+                                     std::shared_ptr<const RobotDescription> robot, std::string_view profile) {
   if (threads < 1) throw std::invalid_argument("threads must be >= 1 (got " + std::to_string(threads) + ")");
   if (steps_per_thread < 1) throw std::invalid_argument("steps must be >= 1 (got " + std::to_string(steps_per_thread) + ")");
-  const auto model = EnvModel::make(task, profile_config(profile));
+  const auto model = EnvModel::make(task, profile_config(profile), std::move(robot));
   std::vector<long long> done(static_cast<std::size_t>(threads), 0);
   const auto t0 = std::chrono::steady_clock::now();
   if (threads == 1) {
     done[0] = run_episodes(model, steps_per_thread, seed);
   } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-      pool.emplace_back([&, t] { done[static_cast<std::size_t>(t)] = run_episodes(model, steps_per_thread, derive_seed({seed, 1000u + static_cast<std::uint64_t>(t)})); });
-    for (auto& th : pool) th.join();
+    run_workers(static_cast<unsigned>(threads), [&](unsigned t) {
+      done[t] = run_episodes(model, steps_per_thread, derive_seed({seed, 1000u + static_cast<std::uint64_t>(t)}));
+    });
   }
   EnvThroughput r;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

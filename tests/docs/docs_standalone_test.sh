@@ -8,7 +8,7 @@ src=${1:?usage: docs_standalone_test.sh SOURCE_DIR}
 cd "$src" || exit 2
 fail=0
 
-pattern='DESIGN §|reference §|facts §|dependency notes|DESIGN sections?|DESIGN\.md|STYLE [0-9]|reference-implementation\.md|maniskill-and-panda-facts'
+pattern='DESIGN §|reference §|facts §|facts sheet|facts [0-9]|dependency notes|DESIGN sections?|DESIGN\.md|STYLE [0-9]|reference-implementation\.md|maniskill-and-panda-facts'
 # this script names the patterns itself, so it is excluded
 hits=$(grep -rnE "$pattern" README.md CMakeLists.txt cmake docs include src apps tests scripts configs 2>/dev/null |
   grep -v '^tests/docs/docs_standalone_test.sh:')

@@ -90,6 +90,12 @@ TEST(Gate1, VerdictsPerCell) {
   EXPECT_EQ(lag.verdict, "descriptive");
   EXPECT_FALSE(report.passed);
   EXPECT_EQ(report.claim_status, "matched_three_seed_ceiling_comparison");
+  // the table says why a cell did not pass, on screen (not only in the verdict file)
+  const std::string md = gate1_to_markdown(report);
+  EXPECT_THAT(md, HasSubstr("- pick_cube/long_lag is descriptive: "));
+  EXPECT_THAT(md, HasSubstr("split 'long_lag' is not gated: only seen and unseen_composition are"));
+  EXPECT_THAT(md, HasSubstr("- pick_cube/unseen_composition is fail: oracle 0.9000 below 0.9500"));
+  EXPECT_EQ(md.find("- pick_cube/seen is"), std::string::npos);
 }
 
 TEST(Gate1, PairedEstimateAndClaimStatus) {

@@ -168,10 +168,62 @@ TEST(Plan, SlurmArrayScript) {
   EXPECT_THAT(s, HasSubstr("#!/bin/bash\n"));
   EXPECT_THAT(s, HasSubstr("#SBATCH --array=0-23%8\n"));
   EXPECT_THAT(s, HasSubstr("#SBATCH --cpus-per-task=4\n"));
+  EXPECT_THAT(s, HasSubstr("job_index=$(( ${ACTIONSHIFT_JOB_OFFSET:-0} + ${SLURM_ARRAY_TASK_ID:?"));
   EXPECT_THAT(s, HasSubstr("'/opt/actionshift/bin/actionshift' run --plan '/data/plans/tiny plan.json' "
-                           "--job-index \"${SLURM_ARRAY_TASK_ID}\" --out '/data/results' --threads"));
+                           "--job-index \"${job_index}\" --out '/data/results' --threads"));
   EXPECT_EQ(s.find("--partition"), std::string::npos);
+  EXPECT_EQ(s.find("--mem"), std::string::npos);
   EXPECT_EQ(shell_quote("it's"), "'it'\\''s'");
+}
+
+TEST(Plan, SlurmChunksStayBelowMaxArraySize) {
+  const auto c = slurm_chunks(1008, 1001);
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(c[0].offset, 0);
+  EXPECT_EQ(c[0].count, 1001);  // indices 0..1000 < 1001
+  EXPECT_EQ(c[1].offset, 1001);
+  EXPECT_EQ(c[1].count, 7);
+  EXPECT_EQ(slurm_chunks(24, 24).size(), 1u);
+  EXPECT_EQ(slurm_chunks(25, 24).size(), 2u);
+  EXPECT_THROW(slurm_chunks(3, 0), std::invalid_argument);
+}
+
+TEST(Plan, ChunkedArraysAndAMergeJobWithAfterokDependency) {
+  const Plan plan = make_plan(parse_experiment(kYaml, "tiny.yaml"), fake_resolver());  // 24 jobs
+  SlurmOptions o;
+  o.plan_path = "/p/tiny.plan.json";
+  o.out_dir = "/r";
+  o.executable = "/bin/actionshift";
+  o.mem = "4G";
+  o.max_array_size = 10;
+  o.script_path = "/r/tiny.sbatch";
+  o.merge_script_path = "/r/tiny.merge.sbatch";
+  const std::string a = slurm_array_script(plan, o);
+  EXPECT_EQ(a.find("#SBATCH --array"), std::string::npos);  // three chunks: the submit script gives --array
+  EXPECT_THAT(a, HasSubstr("#SBATCH --mem=4G\n"));
+  const std::string sub = slurm_submit_script(plan, o);
+  EXPECT_THAT(sub, HasSubstr("sbatch --parsable --array=0-9 --export=ALL,ACTIONSHIFT_JOB_OFFSET=0 '/r/tiny.sbatch'"));
+  EXPECT_THAT(sub, HasSubstr("sbatch --parsable --array=0-9 --export=ALL,ACTIONSHIFT_JOB_OFFSET=10 '/r/tiny.sbatch'"));
+  EXPECT_THAT(sub, HasSubstr("sbatch --parsable --array=0-3 --export=ALL,ACTIONSHIFT_JOB_OFFSET=20 '/r/tiny.sbatch'"));
+  EXPECT_THAT(sub, HasSubstr("--dependency=afterok:\"${dep}\""));
+  EXPECT_THAT(sub, HasSubstr("'/r/tiny.merge.sbatch'"));
+  const std::string m = slurm_merge_script(plan, o);
+  EXPECT_THAT(m, HasSubstr("'/bin/actionshift' summarize '/r' --out '/r/tiny.summary.json' > '/r/tiny.summary.md'"));
+  // the tiny experiment has no oracle/no_adapt pair: no Gate 1
+  EXPECT_EQ(m.find("gate1"), std::string::npos);
+}
+
+TEST(Plan, SlurmTimeMemAndMaxArraySizeParsing) {
+  for (const char* ok : {"30", "30:00", "02:00:00", "1-0", "1-12", "2-12:30", "0-01:00:00", "UNLIMITED", "120:00:00"})
+    EXPECT_TRUE(valid_slurm_time(ok)) << ok;
+  for (const char* bad : {"", "0", "00:00:00", "2h", "1:60", "1:2:3:4", "-1", "1-24", "1-", "1:-5", " 30", "1.5"})
+    EXPECT_FALSE(valid_slurm_time(bad)) << bad;
+  for (const char* ok : {"4G", "4096", "512M", "1T", "100k"}) EXPECT_TRUE(valid_slurm_mem(ok)) << ok;
+  for (const char* bad : {"", "0", "G", "4GB", "-4G", "4.5G"}) EXPECT_FALSE(valid_slurm_mem(bad)) << bad;
+  EXPECT_EQ(parse_max_array_size("Configuration data as of x\nMailProg = /bin/mail\nMaxArraySize            = 4\n"), 4u);
+  EXPECT_EQ(parse_max_array_size("MaxArraySize = 1001"), 1001u);
+  EXPECT_FALSE(parse_max_array_size("MaxJobCount = 10000\n"));
+  EXPECT_FALSE(parse_max_array_size("MaxArraySize = lots\n"));
 }
 
 }  // namespace

@@ -26,7 +26,7 @@ TEST(Kinematics, TcpAtRestIsAboveTheWorldOriginPointingDown) {
   EXPECT_NEAR(world.x(), 0.0, 5e-5);
   EXPECT_NEAR(world.y(), 0.0, 1e-12);
   EXPECT_NEAR(world.z(), 0.1698, 5e-5);
-  // hand z down, hand x along world +x, hand y along world -y (facts 3.2)
+  // hand z down, hand x along world +x, hand y along world -y (the rest keyframe, docs/sim.md §1)
   EXPECT_TRUE(t.linear().col(2).isApprox(Eigen::Vector3d(0, 0, -1), 1e-12));
   EXPECT_TRUE(t.linear().col(0).isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
   EXPECT_TRUE(t.linear().col(1).isApprox(Eigen::Vector3d(0, -1, 0), 1e-12));

@@ -30,7 +30,7 @@ TEST(PandaDescription, ChainLimitsAndMasses) {
   EXPECT_TRUE(f2.axis.isApprox(Eigen::Vector3d(0, -1, 0)));
   double mass = 0;
   for (const auto& l : p.links) mass += l.inertial.mass;
-  EXPECT_NEAR(mass, 17.45, 0.01);  // facts 4.3a total
+  EXPECT_NEAR(mass, 17.45, 0.01);  // total of the published identified inertial set (docs/reference.md, Panda and tasks)
   // four collision boxes per finger
   EXPECT_EQ(p.links[static_cast<std::size_t>(p.link_index("panda_leftfinger"))].collisions.size(), 4u);
   EXPECT_THROW(p.link_index("nope"), std::out_of_range);

@@ -9,9 +9,11 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace actionshift::eval {
 
@@ -40,6 +42,29 @@ struct PoolRef {
   bool operator==(const PoolRef&) const = default;
 };
 
+/// A robot description other than the embedded Panda (`--robot URDF --package NAME=DIR`). Only its
+/// content hash enters the job id; the paths say where to load it from (they are recorded, not hashed,
+/// so moving the files does not change the job).
+struct RobotRef {
+  std::string sha256;                            ///< 64-hex content hash (URDF + collision meshes)
+  std::string urdf;                              ///< absolute URDF path
+  std::map<std::string, std::string> packages;   ///< package name -> absolute directory
+  bool operator==(const RobotRef&) const = default;
+};
+
+/// The files an external policy reads (`--policy-files FILE...`: its script, weights, configuration).
+/// Only their content hash enters the job id, so editing the policy's script makes a new job.
+struct PolicyFilesRef {
+  std::string sha256;                ///< files_content_sha256(paths)
+  std::vector<std::string> paths;    ///< absolute paths, as given (recorded, not hashed)
+  bool operator==(const PolicyFilesRef&) const = default;
+};
+
+/// sha256_hex(canonical_json([sha256_hex(bytes of each file)] sorted)): the content of a set of files,
+/// independent of their names, locations and order. Throws actionshift::InputError(path, field,
+/// "cannot read file") for an unreadable one and for an empty list.
+std::string files_content_sha256(const std::vector<std::string>& paths, const std::string& field = "--policy-files");
+
 /// Accepted values of JobSpec::rotation_mode.
 /// "live": tool frame = live TCP orientation (default, docs/semantics.md §4); "identity": R = I (the reference implementation's headline setting).
 inline constexpr std::string_view kRotationModes[] = {"live", "identity"};
@@ -62,6 +87,8 @@ struct JobSpec {
   std::string profile{"maniskill"};          ///< one of kProfiles: the simulator fidelity profile
   std::uint64_t seed{0};                     ///< experimental seed
   std::int64_t episodes{0};                  ///< number of episodes (> 0)
+  std::optional<RobotRef> robot;             ///< robot description; none = the embedded Panda
+  std::optional<PolicyFilesRef> policy_files;  ///< files of an external policy, or none
   bool operator==(const JobSpec&) const = default;
 };
 
@@ -70,10 +97,16 @@ void validate_job(const JobSpec& job, const std::string& source = "job");
 
 /// The hashed object: {"backbone":{"name","sha256"},"calibration_sha256","episodes",
 /// "method":{"name","params"},"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
-/// "seed","split":{"contracts","name","sha256"},"task"}. Validates first.
+/// "seed","split":{"contracts","name","sha256"},"task"}, plus "robot":{"packages","sha256","urdf"}
+/// only when the job names a robot, and "policy_files":{"paths","sha256"} only when it names policy
+/// files. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 
-/// Canonical JSON text of job_to_json (sorted keys, no whitespace, Python-repr floats).
+/// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"} (paths are
+/// not identity).
+nlohmann::json job_identity_json(const JobSpec& job);
+
+/// Canonical JSON text of job_identity_json (sorted keys, no whitespace, Python-repr floats).
 std::string job_canonical_json(const JobSpec& job);
 
 /// The job id: lowercase 64-hex SHA-256 of job_canonical_json.

@@ -33,6 +33,13 @@ class ResultStore {
   /// and contract index all match). A torn last line is truncated away and logged.
   /// Throws actionshift::InputError (`<file>:<line>: <field>: <reason>`) on anything else, leaving
   /// the file unmodified, or if another process holds the lock.
+  ///
+  /// Growing a job: when the file is new (empty) and `out_dir` holds a *sibling* — a job whose spec
+  /// differs from this one only in `episodes` (same family_key, read from its `<id>.summary.json`) —
+  /// its leading records (episode indices 0..k−1, k ≤ this job's episodes; the sibling with the most)
+  /// are copied in with this job's id, so only the missing episodes run. Episodes are a pure function
+  /// of (seed, contract index, episode index), so the copies equal what a fresh run would write
+  /// (docs/formats.md, "Growing a job").
   static ResultStore open(const std::string& out_dir, const JobSpec& job, const StoreOptions& options = {});
 
   ResultStore(ResultStore&& other) noexcept;
@@ -51,6 +58,9 @@ class ResultStore {
   bool complete() const noexcept { return episodes_done() >= job_.episodes; }
   /// Bytes removed from a torn tail when the store was opened (0: none).
   std::int64_t repaired_bytes() const noexcept { return repaired_bytes_; }
+  /// Records copied from a sibling job when the store was opened (0: none), and that job's id.
+  std::int64_t adopted() const noexcept { return adopted_; }
+  const std::string& adopted_from() const noexcept { return adopted_from_; }
 
   /// Append the next record. It must carry this job's id and episode_index == episodes_done().
   /// Throws std::invalid_argument otherwise, and std::runtime_error if the write fails.
@@ -58,13 +68,20 @@ class ResultStore {
 
  private:
   ResultStore() = default;
+  void adopt_from_sibling(const std::string& out_dir, const StoreOptions& options);
   JobSpec job_;
   std::string id_, path_, summary_path_;
   std::vector<EpisodeRecord> records_;
   std::int64_t repaired_bytes_{0};
+  std::int64_t adopted_{0};
+  std::string adopted_from_;
   bool fsync_{false};
   int fd_{-1};
 };
+
+/// A job's identity without its episode count: canonical JSON of job_identity_json minus "episodes".
+/// Jobs with equal family keys run the same episodes; the one with more episodes extends the other.
+std::string family_key(const JobSpec& job);
 
 /// Check that `r` is record `episode_index` of `job` (id `id`): throws actionshift::InputError(source,
 /// field, reason) naming the first field that differs.

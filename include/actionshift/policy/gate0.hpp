@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -75,6 +76,7 @@ struct Gate0Run {
   Gate0Rule rule{Gate0Rule::kWilsonLower};
   unsigned threads{0};
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (finished, total) over both runs
+  std::shared_ptr<const sim::RobotDescription> robot;  ///< nullptr: the embedded Panda
 };
 
 /// A Gate 0 verdict for one backbone and task.

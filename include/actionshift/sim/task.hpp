@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The five ManiSkill3 table-top tasks: names, horizons, observation layouts, and their success
-/// predicates and dense rewards as pure functions of a state snapshot (facts sheet sections 1, 3.6).
+/// predicates and dense rewards as pure functions of a state snapshot (docs/sim.md §5; docs/reference.md, "Panda and tasks").
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -1,0 +1,77 @@
+#include "actionshift/sim/robot_source.hpp"
+
+#include "actionshift/core/canonical_json.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace actionshift::sim {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_bytes(const std::string& path, const std::string& field) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, field, "cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path, field, "cannot read file");
+  return ss.str();
+}
+
+}  // namespace
+
+std::map<std::string, std::string> parse_package_args(const std::vector<std::string>& args) {
+  std::map<std::string, std::string> out;
+  for (const auto& a : args) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos) throw InputError("--package", a, "expected NAME=DIR");
+    const std::string name = a.substr(0, eq);
+    const std::string dir = a.substr(eq + 1);
+    if (name.empty()) throw InputError("--package", a, "the package name is empty");
+    if (dir.empty()) throw InputError("--package", a, "the directory is empty");
+    if (out.count(name)) throw InputError("--package", a, "package '" + name + "' is given twice");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw InputError("--package", a, "'" + dir + "' is not a directory");
+    out[name] = fs::absolute(dir, ec).lexically_normal().string();
+  }
+  return out;
+}
+
+std::string robot_content_sha256(std::string_view urdf_bytes, const RobotDescription& description) {
+  std::set<std::string> sources;
+  for (const auto& link : description.links)
+    for (const auto& c : link.collisions)
+      if (c.type == CollisionGeometry::Type::kMesh && c.mesh) sources.insert(c.mesh->source);
+  std::set<std::string> mesh_hashes;
+  for (const auto& s : sources) mesh_hashes.insert(sha256_hex(read_bytes(s, "mesh")));
+  nlohmann::json j = nlohmann::json::object();
+  j["urdf"] = sha256_hex(urdf_bytes);
+  j["meshes"] = nlohmann::json::array();
+  for (const auto& h : mesh_hashes) j["meshes"].push_back(h);
+  return sha256_hex(canonical_dump(j));
+}
+
+RobotSource load_robot_source(const std::string& urdf, const std::map<std::string, std::string>& packages) {
+  std::error_code ec;
+  if (!fs::is_regular_file(urdf, ec)) throw InputError(urdf, "--robot", "no such URDF file");
+  RobotSource r;
+  r.urdf = fs::absolute(urdf, ec).lexically_normal().string();
+  r.packages = packages;
+  PackageMap pm;
+  for (const auto& [name, dir] : packages) pm[name] = dir;
+  const std::string bytes = read_bytes(r.urdf, "--robot");
+  auto desc = std::make_shared<RobotDescription>(load_urdf_file(r.urdf, pm));
+  r.sha256 = robot_content_sha256(bytes, *desc);
+  r.description = std::move(desc);
+  return r;
+}
+
+}  // namespace actionshift::sim
