@@ -1,6 +1,7 @@
 // validate, contract hash/decode/encode, splits generate.
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/splits.hpp"
 #include "actionshift/core/transforms.hpp"
 #include "actionshift/core/validate.hpp"
@@ -56,8 +57,7 @@ std::vector<std::pair<std::string, std::string>> input_lines(const std::string& 
 }
 
 nlohmann::json parse_object(const std::string& where, const std::string& line) {
-  nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-  if (j.is_discarded()) throw InputError(where, "", "not valid JSON");
+  const nlohmann::json j = parse_json_input(line, where);
   if (!j.is_object()) throw InputError(where, "", "expected a JSON object");
   return j;
 }

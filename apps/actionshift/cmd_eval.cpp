@@ -3,6 +3,7 @@
 #include "commands.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/gates.hpp"
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/store.hpp"
@@ -41,11 +42,7 @@ json read_json_file(const std::string& path) {
   if (!in) throw InputError(path, "", "cannot open file");
   std::stringstream ss;
   ss << in.rdbuf();
-  try {
-    return json::parse(ss.str());
-  } catch (const json::parse_error&) {
-    throw InputError(path, "", "malformed JSON");
-  }
+  return parse_json_input(ss.str(), path);
 }
 
 void ensure_parent(const std::string& path) {
@@ -81,6 +78,40 @@ void announce(const eval::PlannedJob& pj, std::size_t total, const RunPlanOption
 
 }  // namespace
 
+namespace {
+// the nearest existing ancestor of `p` (or `p` itself) must be a directory
+void check_ancestors(const fs::path& p, const std::string& path, const std::string& option) {
+  std::error_code ec;
+  for (fs::path a = p.parent_path(); !a.empty(); a = a.parent_path()) {
+    if (fs::exists(a, ec)) {
+      if (!fs::is_directory(a, ec)) throw InputError(path, option, a.string() + " exists and is not a directory");
+      return;
+    }
+    if (a == a.parent_path()) return;
+  }
+}
+}  // namespace
+
+void check_output_file(const std::string& path, const std::string& option) {
+  if (path.empty()) throw InputError(path, option, "empty path");
+  std::error_code ec;
+  if (path.back() == '/' || fs::is_directory(path, ec))
+    throw InputError(path, option, "is a directory (expected a file path)");
+  check_ancestors(fs::path(path), path, option);
+}
+
+void check_output_dir(const std::string& path, const std::string& option) {
+  if (path.empty()) throw InputError(path, option, "empty path");
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::exists(p, ec)) {
+    if (!fs::is_directory(p, ec)) throw InputError(path, option, "exists and is not a directory");
+    if (::access(path.c_str(), W_OK | X_OK) != 0) throw InputError(path, option, "directory is not writable");
+    return;
+  }
+  check_ancestors(p, path, option);
+}
+
 eval::ProgressMode parse_progress_mode(const std::string& text) {
   if (text == "auto") return eval::ProgressMode::automatic;
   if (text == "bar") return eval::ProgressMode::bar;
@@ -91,6 +122,7 @@ eval::ProgressMode parse_progress_mode(const std::string& text) {
 
 int run_summarize(const SummarizeOptions& o, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
+    if (!o.out_file.empty()) check_output_file(o.out_file, "--out");
     const eval::ResultSet rs = eval::load_results(o.results_dir);
     for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
     if (rs.records.empty()) throw InputError(o.results_dir, "", "no episode records (*.jsonl) found");
@@ -108,6 +140,7 @@ int run_summarize(const SummarizeOptions& o, std::ostream& out, std::ostream& er
 
 int run_gate1(const Gate1Options& o, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
+    if (!o.verdict_file.empty()) check_output_file(o.verdict_file, "--verdict");
     const eval::ResultSet rs = eval::load_results(o.results_dir);
     for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
     const eval::Gate1Report report = eval::gate1(rs.records, o.samples, o.bootstrap_seed);
@@ -126,6 +159,7 @@ int run_gate_promote(const GatePromoteOptions& o, std::ostream& out, std::ostrea
   return guarded(err, [&] {
     if (o.candidate.empty() || o.baseline.empty() || o.candidate == o.baseline)
       throw InputError("gate promote", "--candidate/--baseline", "give two different methods");
+    if (!o.verdict_file.empty()) check_output_file(o.verdict_file, "--verdict");
     const eval::ResultSet rs = eval::load_results(o.results_dir);
     for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
     const json j = eval::promotion_report(rs.records, o.candidate, o.baseline);
@@ -288,6 +322,7 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
 
 int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
+    check_output_dir(o.out_dir, "--out");
     const eval::Plan plan = eval::load_plan(o.plan_file);
     if (o.job_index) {
       if (*o.job_index < 0 || *o.job_index >= static_cast<std::int64_t>(plan.jobs.size()))
@@ -310,6 +345,7 @@ int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::os
 int run_one_job(const eval::JobSpec& job, const RunPlanOptions& o, const EpisodeFnFactory& make, std::ostream& out,
                 std::ostream& err) {
   return guarded(err, [&] {
+    check_output_dir(o.out_dir, "--out");
     run_with(job, o, make, out, err);
     return kOk;
   });

@@ -99,6 +99,7 @@ struct RunPlanOptions {
   unsigned threads{0};                      // --threads N (0: all cores)
   bool fsync{false};                        // --fsync
   std::string progress{"auto"};             // --progress auto|bar|lines|off
+  double step_timeout_s{10.0};              // --step-timeout S: external policy request/reply bound
 };
 int run_plan_jobs(const RunPlanOptions& options, const EpisodeFnFactory& make_episode_fn,
                   std::ostream& out = std::cout, std::ostream& err = std::cerr);
@@ -108,6 +109,13 @@ int run_plan_jobs(const RunPlanOptions& options, const EpisodeFnFactory& make_ep
 // (plan_file and job_index are ignored).
 int run_one_job(const eval::JobSpec& job, const RunPlanOptions& options, const EpisodeFnFactory& make_episode_fn,
                 std::ostream& out = std::cout, std::ostream& err = std::cerr);
+
+// Output paths are checked before any work starts. A file path (`--out FILE`, `--verdict FILE`) must
+// not be an existing directory, end in '/', or sit below an existing non-directory; a directory path
+// (`--out DIR` of run) must not be an existing non-directory, nor sit below one, and must be writable
+// when it exists. throws actionshift::InputError(path, option, reason).
+void check_output_file(const std::string& path, const std::string& option);
+void check_output_dir(const std::string& path, const std::string& option);
 
 // "auto"|"bar"|"lines"|"off" → ProgressMode; throws actionshift::InputError otherwise.
 eval::ProgressMode parse_progress_mode(const std::string& text);

@@ -41,7 +41,9 @@ std::optional<eval::PolicyFilesRef> cli_policy_files(const std::vector<std::stri
 }
 
 int run_run(const RunCliOptions& o) {
-  const EpisodeFnFactory factory = [](const eval::JobSpec& job) { return eval::make_episode_fn(job); };
+  eval::EpisodeFnOptions options;
+  options.external.step_timeout_s = o.run.step_timeout_s;
+  const EpisodeFnFactory factory = [options](const eval::JobSpec& job) { return eval::make_episode_fn(job, options); };
   if (!o.run.plan_file.empty()) {
     if (!o.robot.urdf.empty() || !o.robot.packages.empty() || !o.policy_files.empty()) {
       std::cerr << "actionshift: error: --plan: " << o.run.plan_file
@@ -76,6 +78,7 @@ int run_plan_cli(const PlanOptions& o, const RobotOptions& robot, const std::vec
 }
 
 int run_calibrate(const CalibrateOptions& o) {
+  if (!o.out.empty()) check_output_file(o.out, "--out");  // before the minutes of work, not after
   sim::EnvConfig cfg;
   try {
     cfg = sim::profile_config(o.profile);
@@ -121,14 +124,22 @@ int run_calibrate(const CalibrateOptions& o) {
   const adapt::ResponseCalibration c = eval::calibrate(model, co);
   if (!o.out.empty()) {
     const std::filesystem::path p(o.out);
-    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+    std::error_code ec;
+    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path(), ec);
+    if (ec) throw InputError(o.out, "--out", "cannot create the parent directory: " + ec.message());
     const std::string tmp = o.out + ".tmp";
+    bool written = false;
     {
       std::ofstream f(tmp, std::ios::binary);
       f << c.to_json() << "\n";
-      if (!f) throw InputError(tmp, "", "cannot write file");
+      f.flush();
+      written = static_cast<bool>(f);
     }
-    std::filesystem::rename(tmp, o.out);
+    if (written) std::filesystem::rename(tmp, o.out, ec);
+    if (!written || ec) {
+      std::filesystem::remove(tmp, ec);  // never leave the temporary file behind
+      throw InputError(o.out, "--out", written ? "cannot rename the temporary file into place" : "cannot write the file");
+    }
   }
   if (o.json) {
     std::cout << c.to_json() << "\n";

@@ -3,6 +3,7 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -69,8 +70,7 @@ std::string ResponseCalibration::to_json() const {
 std::string ResponseCalibration::sha256() const { return sha256_hex(to_json()); }
 
 ResponseCalibration ResponseCalibration::from_json(const std::string& text, const std::string& source) {
-  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
+  const nlohmann::json j = parse_json_input(text, source);
   if (!j.is_object()) throw InputError(source, "", "calibration must be a JSON object");
   if (!j.contains("schema_version")) throw InputError(source, "schema_version", "missing field");
   const bool v1 = j["schema_version"] == kSchemaV1;

@@ -1,6 +1,7 @@
 #include "actionshift/data/builtin_manifests.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/validate.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -45,7 +46,16 @@ std::optional<std::string_view> builtin_manifest_text(std::string_view name) {
 
 Manifest resolve_manifest(const std::string& name_or_path) {
   std::error_code ec;
-  if (std::filesystem::is_regular_file(name_or_path, ec)) return Manifest::load(name_or_path);
+  if (std::filesystem::is_regular_file(name_or_path, ec)) {
+    // a file's stored hashes are verified before it is used: they enter job ids, so an edited copy
+    // must never pass for the manifest it was copied from
+    Manifest m = Manifest::load(name_or_path);
+    for (const Check& c : validate(m, /*regenerate=*/false))
+      if (!c.ok && (c.name == "record_hashes" || c.name == "manifest_hash" || c.name == "pool_hash"))
+        throw InputError(name_or_path, c.name,
+                         "check failed: " + c.detail + " (edited after generation? `actionshift validate` shows every check)");
+    return m;
+  }
   if (auto text = builtin_manifest_text(name_or_path)) return Manifest::parse(*text, "builtin:" + name_or_path);
   std::string known;
   for (const auto& n : builtin_manifest_names()) known += (known.empty() ? "" : ", ") + n;

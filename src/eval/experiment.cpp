@@ -4,12 +4,14 @@
 #include "actionshift/adapt/response.hpp"
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
 #include "actionshift/eval/calibrate.hpp"
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/policy/registry.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 #include "actionshift/sim/robot_source.hpp"
+#include "oracle_access.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -29,8 +31,8 @@ Manifest manifest_of_kind(const std::string& name, bool pool) {
 }
 
 nlohmann::json parse_params(const std::string& text, const std::string& method) {
-  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) throw InputError("method " + method, "params", "not a JSON object");
+  const nlohmann::json j = parse_json_input(text, "method " + method, "params");
+  if (!j.is_object()) throw InputError("method " + method, "params", "not a JSON object");
   return j;
 }
 
@@ -113,14 +115,17 @@ struct Context {
     sim::HiddenContractEnv& env = it->second;
 
     adapt::MethodInputs in;
-    if (job.method == "oracle") in.truth = &truth;  // the only privileged path
+    // the only privileged path: the oracle's view, which only the runner can construct
+    const std::optional<sim::OracleRecorder> oracle =
+        job.method == "oracle" ? std::optional<sim::OracleRecorder>(detail::OracleAccess::view(env)) : std::nullopt;
+    if (oracle) in.truth = &oracle->contract();
     if (!pool.empty()) in.pool = &pool;
     if (response) in.model = &*response;
     const auto adapter = adapt::make_adapter(job.method, params, in);
 
     Eigen::VectorXd obs = env.reset(t.episode_seed);
     w.policy->reset();
-    adapter->begin_episode(t.episode_seed);
+    adapter->begin_episode(t.adapter_seed);  // never the environment's seed: it names the contract
     EpisodeRecord rec;
     rec.contract_sha256 = truth.sha256();
     for (int step = 0; step < env.horizon(); ++step) {
@@ -151,7 +156,7 @@ struct Context {
 
 }  // namespace
 
-EpisodeFn make_episode_fn(const JobSpec& job) {
+EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) {
   validate_job(job);
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
@@ -200,7 +205,9 @@ EpisodeFn make_episode_fn(const JobSpec& job) {
       throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
     ctx->response = cal.model();
   }
-  ctx->prototype = policy::make_policy(job.backbone.name, task);
+  policy::RegistryOptions registry;
+  registry.external = options.external;
+  ctx->prototype = policy::make_policy(job.backbone.name, task, registry);
   if (ctx->prototype->sha256() != job.backbone.sha256)
     throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
   ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));

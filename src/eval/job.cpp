@@ -3,6 +3,7 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -51,12 +52,7 @@ std::string str_at(const json& j, const char* key, const std::string& src, const
 }
 
 json parse_params(const std::string& text, const std::string& src) {
-  json p;
-  try {
-    p = json::parse(text);
-  } catch (const json::parse_error&) {
-    throw InputError(src, "method.params", "malformed JSON object text");
-  }
+  const json p = parse_json_input(text, src, "method.params");
   if (!p.is_object()) throw InputError(src, "method.params", "expected a JSON object (got " + p.dump() + ")");
   return p;
 }
@@ -245,6 +241,11 @@ std::uint64_t splitmix64(std::uint64_t x) noexcept {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
+}
+
+std::uint64_t adapter_episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept {
+  constexpr std::uint64_t kAdapterDomain = 0x61646170746572ull;  // "adapter"
+  return splitmix64(splitmix64(seed ^ kAdapterDomain) ^ static_cast<std::uint64_t>(contract_episode));
 }
 
 std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept {

@@ -3,6 +3,7 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/store.hpp"
 #include "io.hpp"
 
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <sstream>
@@ -57,20 +59,61 @@ std::optional<double> as_float(const YAML::Node& n) {
   return v;
 }
 
-// YAML → JSON for method parameters (core schema: null, bool, int, float, string, lists, maps)
-json to_json_value(const YAML::Node& n, const std::string& source, const std::string& field) {
+constexpr std::size_t kMaxExperimentBytes = std::size_t{1} << 20;  // an experiment file is a few hundred bytes
+constexpr std::size_t kMaxParamNodes = 10000;                         // values in one method's params
+
+// Deepest flow-collection ([ ], { }) nesting outside quotes and comments. yaml-cpp's parser recurses
+// once per level, so `[[[[…` 100,000 deep would overflow the stack; this scan runs before it.
+int yaml_flow_depth(std::string_view text) {
+  int depth = 0, deepest = 0;
+  char quote = 0;
+  bool comment = false;
+  char prev = '\n';
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (comment) {
+      if (c == '\n') comment = false;
+    } else if (quote != 0) {
+      if (c == '\\' && quote == '"') ++i;
+      else if (c == quote) quote = 0;
+    } else if (c == '#' && (prev == ' ' || prev == '\t' || prev == '\n')) {
+      comment = true;
+    } else if ((c == '"' || c == '\'') && (prev == ' ' || prev == '\t' || prev == '\n' || prev == '[' || prev == '{' ||
+                                           prev == ',' || prev == ':' || prev == '-')) {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+    prev = c;
+  }
+  return deepest;
+}
+
+// YAML → JSON for method parameters (core schema: null, bool, int, float, string, lists, maps); depth
+// and size are bounded (aliases can make a small file name an exponentially large tree)
+json to_json_value(const YAML::Node& n, const std::string& source, const std::string& field, int depth = 0,
+                   std::size_t* budget = nullptr) {
+  std::size_t own_budget = kMaxParamNodes;
+  if (budget == nullptr) budget = &own_budget;
+  if (*budget == 0) throw InputError(at_line(source, n), field, "more than " + std::to_string(kMaxParamNodes) + " values");
+  --*budget;
+  if (depth >= kMaxJsonDepth)
+    throw InputError(at_line(source, n), field, "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   if (!n || n.IsNull()) return nullptr;
   if (n.IsSequence()) {
     json a = json::array();
     for (std::size_t i = 0; i < n.size(); ++i)
-      a.push_back(to_json_value(n[i], source, field + "[" + std::to_string(i) + "]"));
+      a.push_back(to_json_value(n[i], source, field + "[" + std::to_string(i) + "]", depth + 1, budget));
     return a;
   }
   if (n.IsMap()) {
     json o = json::object();
     for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) throw InputError(at_line(source, kv.first), field, "map keys must be plain names");
       const std::string key = kv.first.Scalar();
-      o[key] = to_json_value(kv.second, source, field + "." + key);
+      o[key] = to_json_value(kv.second, source, field + "." + key, depth + 1, budget);
     }
     return o;
   }
@@ -122,12 +165,19 @@ void check_json_keys(const json& j, const std::set<std::string>& keys, const std
 }  // namespace
 
 Experiment parse_experiment(std::string_view text, const std::string& source) {
+  if (text.size() > kMaxExperimentBytes)
+    throw InputError(source, "", "experiment file too large (" + std::to_string(text.size()) + " bytes, at most " +
+                                     std::to_string(kMaxExperimentBytes) + ")");
+  if (yaml_flow_depth(text) > kMaxJsonDepth)
+    throw InputError(source, "", "malformed YAML: [ ] / { } nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   YAML::Node root;
   try {
     root = YAML::Load(std::string(text));
   } catch (const YAML::Exception& e) {
     const std::string where = e.mark.line >= 0 ? source + ":" + std::to_string(e.mark.line + 1) : source;
     throw InputError(where, "", "malformed YAML: " + e.msg);
+  } catch (const std::exception& e) {
+    throw InputError(source, "", std::string("malformed YAML: ") + e.what());
   }
   if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
   static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
@@ -227,7 +277,15 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   return ex;
 }
 
-Experiment load_experiment(const std::string& path) { return parse_experiment(detail::read_file(path), path); }
+Experiment load_experiment(const std::string& path) {
+  // refuse an oversized file before reading it into memory
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxExperimentBytes)
+    throw InputError(path, "", "experiment file too large (" + std::to_string(size) + " bytes, at most " +
+                                   std::to_string(kMaxExperimentBytes) + ")");
+  return parse_experiment(detail::read_file(path), path);
+}
 
 JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("resolve_job: resolver needs split and backbone");
@@ -344,13 +402,7 @@ Plan plan_from_json(const nlohmann::json& j, const std::string& source) {
 
 Plan load_plan(const std::string& path) {
   const std::string text = detail::read_file(path);
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error&) {
-    throw InputError(path, "", "malformed JSON plan file");
-  }
-  return plan_from_json(j, path);
+  return plan_from_json(parse_json_input(text, path), path);
 }
 
 void write_plan(const std::string& path, const Plan& plan) { write_json_atomic(path, plan_to_json(plan)); }

@@ -3,6 +3,7 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -177,16 +178,7 @@ EpisodeRecord record_from_json(const nlohmann::json& j, const std::string& src) 
 }
 
 EpisodeRecord parse_record_line(std::string_view line, const std::string& src) {
-  json j;
-  try {
-    j = json::parse(line);
-  } catch (const json::parse_error& e) {
-    // nlohmann's message carries a byte offset; keep only the explanation
-    std::string what = e.what();
-    const auto pos = what.find("parse error");
-    throw InputError(src, "", "malformed JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
-  }
-  return record_from_json(j, src);
+  return record_from_json(parse_json_input(line, src), src);
 }
 
 RecordFile read_record_file(const std::string& path, bool allow_torn_tail) {

@@ -136,8 +136,14 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
         if (failure && i > failed_at) return;
       }
       const auto slot = episode_slot(job.split.contracts, i);
-      EpisodeTask task{&job, job.seed, slot.contract_index, slot.contract_episode, i,
-                       episode_seed(job.seed, slot.contract_index, i), w};
+      EpisodeTask task{&job,
+                       job.seed,
+                       slot.contract_index,
+                       slot.contract_episode,
+                       i,
+                       episode_seed(job.seed, slot.contract_index, i),
+                       adapter_episode_seed(job.seed, slot.contract_episode),
+                       w};
       try {
         EpisodeRecord r = fn(task);
         // stamp the job fields; the episode function owns only the outcome and contract hash
@@ -213,12 +219,20 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
     message = "complete: " + std::to_string(job.episodes) + " episodes" +
               (first > 0 ? " (resumed after " + std::to_string(first) + ")" : "");
   }
-  write_json_atomic(store.summary_path(),
-                    make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
   if (failure) {
+    // the first error is the one reported: on a full disk the summary cannot be written either,
+    // and its error would hide the JSONL append that failed first
+    try {
+      write_json_atomic(store.summary_path(),
+                        make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
+    } catch (const std::exception& e) {
+      log << "\nactionshift: note: job summary not written either (" << e.what() << ")\n";
+    }
     if (options.progress != ProgressMode::off) log << "\n";
     std::rethrow_exception(failure);
   }
+  write_json_atomic(store.summary_path(),
+                    make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
   progress.finish(store.episodes_done());
   return result;
 }

@@ -2,6 +2,7 @@
 #include "actionshift/policy/external.hpp"
 
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -53,6 +54,17 @@ struct ExternalPolicy::Process {
 };
 
 namespace {
+constexpr std::size_t kMaxReplyBytes = std::size_t{1} << 20;
+
+// a reply as JSON, or a discarded value for anything else (too deep, malformed, out-of-range numbers)
+nlohmann::json parse_reply(const std::string& reply) {
+  try {
+    return parse_json_input(reply, "reply");
+  } catch (const InputError&) {
+    return nlohmann::json(nlohmann::json::value_t::discarded);
+  }
+}
+
 std::string excerpt(const std::string& s) {
   std::string e = s.size() > 80 ? s.substr(0, 80) + "..." : s;
   for (char& c : e)
@@ -60,6 +72,28 @@ std::string excerpt(const std::string& s) {
   return e;
 }
 }  // namespace
+
+Action parse_step_reply(std::string_view reply) {
+  const nlohmann::json j = parse_reply(std::string(reply));
+  if (j.is_discarded()) throw std::invalid_argument("not JSON");
+  if (!j.is_object() || !j.contains("action")) throw std::invalid_argument("expected {\"action\": [7 numbers]}");
+  const nlohmann::json& a = j.at("action");
+  if (!a.is_array() || a.size() != static_cast<std::size_t>(kActionDim))
+    throw std::invalid_argument("action must be an array of 7 numbers");
+  Action out;
+  for (int i = 0; i < kActionDim; ++i) {
+    const nlohmann::json& v = a.at(static_cast<std::size_t>(i));
+    if (!v.is_number()) throw std::invalid_argument("action must be an array of 7 numbers");
+    out(i) = v.get<double>();
+    if (!std::isfinite(out(i))) throw std::invalid_argument("non-finite action");
+  }
+  return out;
+}
+
+bool is_ready_reply(std::string_view reply) {
+  const nlohmann::json j = parse_reply(std::string(reply));
+  return !j.is_discarded() && j.is_object() && j.contains("type") && j.at("type") == "ready";
+}
 
 ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options)
     : command_(std::move(command)), task_(task), options_(options), proc_(std::make_unique<Process>()) {
@@ -91,6 +125,9 @@ ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOp
   close(out_pipe[1]);
   proc_->to_child = in_pipe[1];
   proc_->from_child = out_pipe[0];
+  // non-blocking on our side: every read and write waits in poll() with the protocol's timeouts
+  fcntl(proc_->to_child, F_SETFL, fcntl(proc_->to_child, F_GETFL) | O_NONBLOCK);
+  fcntl(proc_->from_child, F_SETFL, fcntl(proc_->from_child, F_GETFL) | O_NONBLOCK);
   if (rc != 0) {
     proc_->pid = -1;
     fail("start", std::strerror(rc));
@@ -104,10 +141,9 @@ ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOp
                           {"horizon", sim::task_horizon(task_)},
                           {"control_dt_s", 0.05},
                           {"layout", nlohmann::json::parse(layout.to_json())}};
-  send(hello.dump(), "hello");
+  send(hello.dump(), "hello", options_.hello_timeout_s);
   const std::string reply = receive(options_.hello_timeout_s, "hello");
-  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("type") || j.at("type") != "ready")
+  if (!is_ready_reply(reply))
     fail("hello", "expected {\"type\":\"ready\"}, got '" + excerpt(reply) + "'");
 }
 
@@ -123,13 +159,54 @@ void ExternalPolicy::fail(const std::string& what, const std::string& reason) {
   throw std::runtime_error("external policy '" + command_ + "': " + what + ": " + reason);
 }
 
-void ExternalPolicy::send(const std::string& line, const char* what) {
-  std::string data = line + "\n";
+bool ExternalPolicy::read_some(const char* what) {
+  char chunk[4096];
+  for (;;) {
+    const ssize_t n = read(proc_->from_child, chunk, sizeof chunk);
+    if (n > 0) {
+      proc_->buffer.append(chunk, static_cast<std::size_t>(n));
+      if (proc_->buffer.size() > kMaxReplyBytes) fail(what, "reply line longer than 1 MiB");
+      return true;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return false;
+    // end of stream: the process closed stdout or died; wait briefly for its status
+    for (int i = 0; i < 50 && !proc_->poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    fail(what, proc_->exited ? proc_->exit_text() + " before replying" : std::string("process closed its stdout"));
+  }
+}
+
+void ExternalPolicy::check_no_pending_output(const char* what) {
+  // the protocol is strictly one reply per step request: whatever arrived since the last reply was
+  // not asked for (a second reply, or a reply to a reset), and would make every later reply lag
+  pollfd p{proc_->from_child, POLLIN, 0};
+  while (proc_->buffer.empty() && poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLHUP | POLLERR)) != 0) {
+    if (!read_some(what)) break;
+  }
+  if (!proc_->buffer.empty())
+    fail(what, "protocol error: output that no request asked for (an extra reply?): '" + excerpt(proc_->buffer) + "'");
+}
+
+void ExternalPolicy::send(const std::string& line, const char* what, double timeout_s) {
+  check_no_pending_output(what);
+  const std::string data = line + "\n";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   std::size_t off = 0;
   while (off < data.size()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0)
+      fail(what, "the process did not read its request within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
+    // watch stdout too: a process that writes instead of reading would otherwise block both sides
+    pollfd p[2] = {{proc_->to_child, POLLOUT, 0}, {proc_->from_child, POLLIN, 0}};
+    const int r = poll(p, 2, static_cast<int>(std::min<long long>(left.count(), 100)));
+    if (r < 0 && errno != EINTR) fail(what, std::string("poll failed: ") + std::strerror(errno));
+    if (r <= 0) continue;
+    if ((p[1].revents & (POLLIN | POLLHUP | POLLERR)) != 0 && read_some(what))
+      fail(what, "protocol error: output before the request was read (an extra reply?): '" + excerpt(proc_->buffer) + "'");
+    if ((p[0].revents & (POLLOUT | POLLERR | POLLHUP)) == 0) continue;
     const ssize_t n = write(proc_->to_child, data.data() + off, data.size() - off);
     if (n < 0) {
-      if (errno == EINTR) continue;
+      if (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK) continue;
       if (proc_->poll_exit()) fail(what, proc_->exit_text());
       fail(what, std::string("write failed: ") + std::strerror(errno));
     }
@@ -144,24 +221,17 @@ std::string ExternalPolicy::receive(double timeout_s, const char* what) {
     if (nl != std::string::npos) {
       std::string line = proc_->buffer.substr(0, nl);
       proc_->buffer.erase(0, nl + 1);
+      if (!proc_->buffer.empty())
+        fail(what, "protocol error: more than one reply line to one request: '" + excerpt(proc_->buffer) + "'");
       return line;
     }
-    if (proc_->buffer.size() > (1u << 20)) fail(what, "reply line longer than 1 MiB");
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) fail(what, "no reply within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
     pollfd p{proc_->from_child, POLLIN, 0};
     const int r = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 100)));
     if (r < 0 && errno != EINTR) fail(what, std::string("poll failed: ") + std::strerror(errno));
     if (r <= 0) continue;
-    char chunk[4096];
-    const ssize_t n = read(proc_->from_child, chunk, sizeof chunk);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      // end of stream: the process closed stdout or died; wait briefly for its status
-      for (int i = 0; i < 50 && !proc_->poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      fail(what, proc_->exited ? proc_->exit_text() + " before replying" : std::string("process closed its stdout"));
-    }
-    proc_->buffer.append(chunk, static_cast<std::size_t>(n));
+    read_some(what);
   }
 }
 
@@ -173,27 +243,20 @@ void ExternalPolicy::reset() {
                         {"episode", episode_},
                         {"task", std::string(sim::task_name(task_))},
                         {"layout", nlohmann::json::parse(layout.to_json())}};
-  send(msg.dump(), "reset");
+  send(msg.dump(), "reset", options_.step_timeout_s);
 }
 
 Action ExternalPolicy::act(const Eigen::Ref<const Eigen::VectorXd>& obs) {
   check_observation(obs, task_);
   const std::string what = "step " + std::to_string(step_);
   nlohmann::json msg = {{"type", "step"}, {"t", step_}, {"obs", std::vector<double>(obs.data(), obs.data() + obs.size())}};
-  send(msg.dump(), what.c_str());
+  send(msg.dump(), what.c_str(), options_.step_timeout_s);
   const std::string reply = receive(options_.step_timeout_s, what.c_str());
-  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
-  auto garbage = [&](const std::string& why) { fail(what, "bad reply (" + why + "): '" + excerpt(reply) + "'"); };
-  if (j.is_discarded()) garbage("not JSON");
-  if (!j.is_object() || !j.contains("action")) garbage("expected {\"action\": [7 numbers]}");
-  const nlohmann::json& a = j.at("action");
-  if (!a.is_array() || a.size() != static_cast<std::size_t>(kActionDim)) garbage("action must be an array of 7 numbers");
   Action out;
-  for (int i = 0; i < kActionDim; ++i) {
-    const nlohmann::json& v = a.at(static_cast<std::size_t>(i));
-    if (!v.is_number()) garbage("action must be an array of 7 numbers");
-    out(i) = v.get<double>();
-    if (!std::isfinite(out(i))) garbage("non-finite action");
+  try {
+    out = parse_step_reply(reply);
+  } catch (const std::invalid_argument& e) {
+    fail(what, "bad reply (" + std::string(e.what()) + "): '" + excerpt(reply) + "'");
   }
   ++step_;
   return out;

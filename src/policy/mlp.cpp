@@ -3,6 +3,7 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/rng.hpp"
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -22,6 +25,7 @@ constexpr char kMagic[8] = {'A', 'S', 'M', 'L', 'P', 'W', '\0', '\1'};
 constexpr std::uint32_t kFormatVersion = 1;
 constexpr std::uint32_t kMaxHeaderBytes = 1u << 20;
 constexpr int kMaxLayerWidth = 4096;
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;  // 1 GiB; the shipped networks are < 1 MiB
 
 static_assert(std::endian::native == std::endian::little, "the .asmlp reader assumes a little-endian host");
 
@@ -119,20 +123,31 @@ MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   const std::uint32_t hlen = get_u32(bytes, 12);
   if (hlen > kMaxHeaderBytes || 16 + static_cast<std::size_t>(hlen) > bytes.size())
     throw fail("header", "truncated file: header of " + std::to_string(hlen) + " bytes does not fit");
-  const nlohmann::json h = nlohmann::json::parse(bytes.substr(16, hlen), nullptr, false);
-  if (h.is_discarded() || !h.is_object()) throw fail("header", "header is not a JSON object");
+  const nlohmann::json h = parse_json_input(bytes.substr(16, hlen), source, "header");
+  if (!h.is_object()) throw fail("header", "header is not a JSON object");
   auto need = [&](const char* key) -> const nlohmann::json& {
     if (!h.contains(key)) throw fail(std::string("header.") + key, "missing");
     return h.at(key);
+  };
+  // a JSON integer that fits an int; nlohmann's get<int>() would convert 1e30 with undefined behaviour
+  auto small_int = [&](const nlohmann::json& v, const std::string& field) -> int {
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
+      return static_cast<int>(v.get<std::uint64_t>());
+    if (v.is_number_integer() && !v.is_number_unsigned() && v.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+        v.get<std::int64_t>() <= std::numeric_limits<int>::max())
+      return static_cast<int>(v.get<std::int64_t>());
+    throw fail(field, "expected an integer in the range of int (got " + v.dump() + ")");
   };
   MlpWeights w;
   try {
     if (need("format") != "actionshift-mlp") throw fail("header.format", "expected \"actionshift-mlp\"");
     w.task = sim::parse_task(need("task").get<std::string>());
-    w.history = need("history").get<int>();
+    w.history = small_int(need("history"), "header.history");
     if (w.history != 0 && w.history != kHistoryLength)
       throw fail("header.history", "must be 0 or " + std::to_string(kHistoryLength) + " (got " + std::to_string(w.history) + ")");
-    w.layers = need("layers").get<std::vector<int>>();
+    const nlohmann::json& layers = need("layers");
+    if (!layers.is_array()) throw fail("header.layers", "expected a list of integers");
+    for (const auto& n : layers) w.layers.push_back(small_int(n, "header.layers"));
     if (h.contains("training")) w.training = h.at("training");
   } catch (const nlohmann::json::exception& e) {
     throw fail("header", std::string("wrong field type: ") + e.what());
@@ -199,9 +214,16 @@ void save_mlp(const MlpWeights& w, const std::string& path) {
 
 namespace {
 std::string read_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a weight file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxFileBytes)
+    throw InputError(path, "", "weight file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(kMaxFileBytes) + ")");
   std::ifstream f(path, std::ios::binary);
   if (!f) throw InputError(path, "", "cannot open weight file");
-  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  std::string bytes(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>{});
+  if (f.bad()) throw InputError(path, "", "read error");
+  return bytes;
 }
 }  // namespace
 

@@ -4,13 +4,18 @@
 #include "actionshift/core/error.hpp"
 
 #include <assimp/Importer.hpp>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <set>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -36,6 +41,9 @@ Eigen::Isometry3d to_iso(const urdf::Pose& p) {
   throw InputError(std::string(origin), "", what);
 }
 
+constexpr std::size_t kMaxMeshNodes = 100000;  // scene-graph nodes per mesh file
+constexpr int kMaxXmlDepth = 64;                // element nesting; a URDF needs about 5
+
 // process-wide cache of unscaled meshes keyed by resolved path
 std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& file, std::string_view origin) {
   static std::mutex mutex;
@@ -49,24 +57,35 @@ std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& fi
   if (!std::filesystem::is_regular_file(file, ec))
     fail(origin, "mesh file not found: " + key);
   Assimp::Importer importer;
+  // Collada files carry an <up_axis>; assimp rotates Z_UP files into its Y-up convention by default,
+  // which would turn a .dae collision mesh 90 degrees about x relative to its STL/OBJ twin. A URDF
+  // mesh's vertices are coordinates in the link frame, whatever the exporter's notion of "up".
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const aiScene* scene = importer.ReadFile(key, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || scene->mRootNode == nullptr || scene->mNumMeshes == 0)
     fail(origin, "cannot read mesh " + key + " (" + importer.GetErrorString() + ")");
   auto mesh = std::make_shared<MeshData>();
   mesh->source = key;
-  // walk the node tree so node transforms are applied
-  std::function<void(const aiNode*, const aiMatrix4x4&)> walk = [&](const aiNode* node, const aiMatrix4x4& parent) {
+  // walk the node tree (explicitly, a hostile file may nest nodes deeply) so node transforms are applied
+  std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{{scene->mRootNode, aiMatrix4x4()}};
+  std::size_t visited = 0;
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    if (++visited > kMaxMeshNodes) fail(origin, "mesh " + key + " has more than " + std::to_string(kMaxMeshNodes) + " nodes");
     const aiMatrix4x4 m = parent * node->mTransformation;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      if (node->mMeshes[i] >= scene->mNumMeshes) fail(origin, "mesh " + key + ": a node names a mesh that does not exist");
       const aiMesh* am = scene->mMeshes[node->mMeshes[i]];
       for (unsigned v = 0; v < am->mNumVertices; ++v) {
         const aiVector3D p = m * am->mVertices[v];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+          fail(origin, "mesh " + key + " has a non-finite vertex");
         mesh->vertices.emplace_back(p.x, p.y, p.z);
       }
     }
-    for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], m);
-  };
-  walk(scene->mRootNode, aiMatrix4x4());
+    for (unsigned c = 0; c < node->mNumChildren; ++c) stack.emplace_back(node->mChildren[c], m);
+  }
   if (mesh->vertices.size() < 4) fail(origin, "mesh " + key + " has fewer than 4 vertices");
   std::lock_guard<std::mutex> lock(mutex);
   return cache.emplace(key, std::move(mesh)).first->second;
@@ -89,18 +108,109 @@ std::filesystem::path resolve_uri(const std::string& uri, const std::filesystem:
   return p.is_absolute() ? p : base_dir / p;
 }
 
+// Deepest element nesting of an XML text, computed without recursion. urdfdom's XML parser
+// (tinyxml) recurses once per nesting level, so a hostile file nested 100,000 deep would overflow
+// the stack before urdfdom could reject it; this scan runs first. Comments, CDATA, processing
+// instructions, declarations and quoted attribute values are skipped.
+int xml_depth(std::string_view xml) {
+  int depth = 0, deepest = 0;
+  std::size_t i = 0;
+  const auto skip_past = [&](std::string_view end) {
+    const auto e = xml.find(end, i);
+    i = e == std::string_view::npos ? xml.size() : e + end.size();
+  };
+  while ((i = xml.find('<', i)) != std::string_view::npos) {
+    const std::string_view rest = xml.substr(i);
+    if (rest.starts_with("<!--")) { skip_past("-->"); continue; }
+    if (rest.starts_with("<![CDATA[")) { skip_past("]]>"); continue; }
+    if (rest.starts_with("<?")) { skip_past("?>"); continue; }
+    if (rest.starts_with("<!")) { skip_past(">"); continue; }
+    const bool closing = rest.starts_with("</");
+    char quote = 0, last = 0;
+    for (++i; i < xml.size(); ++i) {
+      const char c = xml[i];
+      if (quote != 0) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '>') {
+        break;
+      } else if (c != ' ' && c != '\t' && c != '\n' && c != '\r') {
+        last = c;
+      }
+    }
+    if (closing) {
+      depth = depth > 0 ? depth - 1 : 0;
+    } else if (last != '/') {
+      deepest = std::max(deepest, ++depth);
+    }
+    if (i < xml.size()) ++i;
+  }
+  return deepest;
+}
+
+// Collects what urdfdom reports through console_bridge while it parses, so the reason for a
+// rejection reaches the project's one-line error instead of stderr. console_bridge's handler is
+// process-global, hence the mutex around every parse.
+class CapturingHandler final : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN && first_.empty()) first_ = text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) last_error_ = text;
+  }
+  std::string reason() const { return last_error_.empty() ? first_ : last_error_; }
+
+ private:
+  std::string first_, last_error_;
+};
+
+urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::string_view origin) {
+  static std::mutex mutex;
+  std::lock_guard<std::mutex> lock(mutex);
+  CapturingHandler handler;
+  console_bridge::useOutputHandler(&handler);
+  urdf::ModelInterfaceSharedPtr model;
+  try {
+    model = urdf::parseURDF(xml);
+  } catch (const std::exception& e) {
+    console_bridge::restorePreviousOutputHandler();
+    fail(origin, std::string("not a valid URDF: ") + e.what());
+  }
+  console_bridge::restorePreviousOutputHandler();
+  if (!model || !model->getRoot()) {
+    std::string why = handler.reason();
+    for (char& c : why) if (c == '\n' || c == '\r') c = ' ';
+    while (!why.empty() && why.back() == ' ') why.pop_back();
+    fail(origin, "not a valid URDF: " + (why.empty() ? std::string("urdfdom could not parse it") : why));
+  }
+  return model;
+}
+
+bool finite(const Eigen::Isometry3d& t) { return t.matrix().allFinite(); }
+
+// A physical inertia tensor: finite, symmetric, positive semi-definite, and its principal moments
+// obey the triangle inequality (no moment exceeds the sum of the other two).
+std::string inertia_problem(const Eigen::Matrix3d& in) {
+  if (!in.allFinite()) return "inertia is not finite";
+  const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(in, Eigen::EigenvaluesOnly).eigenvalues();
+  const double tol = 1e-9 * std::max(1.0, m.cwiseAbs().maxCoeff());
+  if (m.minCoeff() < -tol) return "inertia is not positive semi-definite (a principal moment is negative)";
+  if (m(2) > m(0) + m(1) + tol) return "inertia violates the triangle inequality (one principal moment exceeds the sum of the other two)";
+  return {};
+}
+
 }  // namespace
 
 int RobotDescription::link_index(std::string_view link) const {
   for (std::size_t i = 0; i < links.size(); ++i)
     if (links[i].name == link) return static_cast<int>(i);
-  throw std::out_of_range("robot '" + name + "' has no link '" + std::string(link) + "'");
+  throw InputError("robot '" + name + "'", "link", "no link named '" + std::string(link) + "'");
 }
 
 int RobotDescription::joint_index(std::string_view joint) const {
   for (std::size_t i = 0; i < joints.size(); ++i)
     if (joints[i].name == joint) return static_cast<int>(i);
-  throw std::out_of_range("robot '" + name + "' has no joint '" + std::string(joint) + "'");
+  throw InputError("robot '" + name + "'", "joint", "no joint named '" + std::string(joint) + "'");
 }
 
 int RobotDescription::parent_joint(int link) const {
@@ -129,18 +239,30 @@ Eigen::Isometry3d RobotDescription::link_pose(int link, const std::vector<double
 
 RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& base_dir, const PackageMap& packages,
                             std::string_view origin) {
-  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(std::string(xml));
-  if (!model || !model->getRoot()) fail(origin, "not a valid URDF (urdfdom could not parse it)");
+  if (xml_depth(xml) > kMaxXmlDepth)
+    fail(origin, "not a valid URDF: XML elements nested deeper than " + std::to_string(kMaxXmlDepth) + " levels");
+  const urdf::ModelInterfaceSharedPtr model = parse_with_reason(std::string(xml), origin);
   RobotDescription out;
   out.name = model->getName();
 
-  // depth-first over the tree so every parent precedes its children
+  // depth-first over the tree so every parent precedes its children; iterative, and a link reached
+  // twice (a joint closing a loop, or a link with two parent joints) is rejected: urdfdom keeps only
+  // the last parent of such a link and would leave a cycle behind
   std::vector<urdf::LinkConstSharedPtr> order;
-  std::function<void(const urdf::LinkConstSharedPtr&)> visit = [&](const urdf::LinkConstSharedPtr& l) {
+  std::set<std::string> seen;
+  std::vector<urdf::LinkConstSharedPtr> pending{model->getRoot()};
+  while (!pending.empty()) {
+    const urdf::LinkConstSharedPtr l = pending.back();
+    pending.pop_back();
+    if (!seen.insert(l->name).second)
+      fail(origin, "link " + l->name + ": reached twice from the root (a kinematic loop or two parent joints); "
+                   "only kinematic trees are supported");
     order.push_back(l);
-    for (const auto& child : l->child_links) visit(child);
-  };
-  visit(model->getRoot());
+    for (auto it = l->child_links.rbegin(); it != l->child_links.rend(); ++it) pending.push_back(*it);
+  }
+  if (order.size() != model->links_.size())
+    fail(origin, "not a valid URDF: " + std::to_string(model->links_.size() - std::min(model->links_.size(), order.size())) +
+                     " link(s) are not connected to the root " + model->getRoot()->name);
   std::map<std::string, int> index;
   for (const auto& l : order) index[l->name] = static_cast<int>(index.size());
   out.root = 0;
@@ -158,11 +280,14 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
       ld.inertial.inertia = o.linear() * in * o.linear().transpose();
       if (!(ld.inertial.mass >= 0.0) || !std::isfinite(ld.inertial.mass))
         fail(origin, "link " + l->name + ": inertial mass must be finite and >= 0");
+      if (!finite(o)) fail(origin, "link " + l->name + ": inertial origin is not finite");
+      if (const std::string why = inertia_problem(in); !why.empty()) fail(origin, "link " + l->name + ": " + why);
     }
     for (const auto& c : l->collision_array) {
       if (!c || !c->geometry) continue;
       CollisionGeometry g;
       g.origin = to_iso(c->origin);
+      if (!finite(g.origin)) fail(origin, "link " + l->name + ": collision origin is not finite");
       switch (c->geometry->type) {
         case urdf::Geometry::BOX: {
           const auto& b = static_cast<const urdf::Box&>(*c->geometry);
@@ -188,6 +313,8 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
           const auto file = resolve_uri(m.filename, base_dir, packages, origin);
           auto raw = load_mesh_cached(file, origin);
           const Eigen::Vector3d s(m.scale.x, m.scale.y, m.scale.z);
+          if (!s.allFinite() || !(s.cwiseAbs().minCoeff() > 0.0))
+            fail(origin, "link " + l->name + ": mesh scale must be finite and non-zero");
           if (s == Eigen::Vector3d::Ones()) {
             g.mesh = raw;
           } else {
@@ -198,6 +325,10 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
           break;
         }
       }
+      if (g.type != CollisionGeometry::Type::kMesh && !(g.size.allFinite() && g.size.minCoeff() >= 0.0 && g.size.x() > 0.0 &&
+                                                        (g.type != CollisionGeometry::Type::kBox || g.size.minCoeff() > 0.0) &&
+                                                        (g.type != CollisionGeometry::Type::kCylinder || g.size.y() > 0.0)))
+        fail(origin, "link " + l->name + ": collision shape dimensions must be finite and positive");
       ld.collisions.push_back(std::move(g));
     }
     out.links.push_back(std::move(ld));
@@ -210,6 +341,7 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
       jd.parent = index.at(j->parent_link_name);
       jd.child = index.at(j->child_link_name);
       jd.origin = to_iso(j->parent_to_joint_origin_transform);
+      if (!finite(jd.origin)) fail(origin, "joint " + j->name + ": origin is not finite");
       switch (j->type) {
         case urdf::Joint::REVOLUTE: jd.type = JointDescription::Type::kRevolute; break;
         case urdf::Joint::CONTINUOUS: jd.type = JointDescription::Type::kContinuous; break;
@@ -219,7 +351,7 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
       }
       Eigen::Vector3d axis(j->axis.x, j->axis.y, j->axis.z);
       if (jd.movable()) {
-        if (!(axis.norm() > 1e-12)) fail(origin, "joint " + j->name + ": zero axis");
+        if (!axis.allFinite() || !(axis.norm() > 1e-12)) fail(origin, "joint " + j->name + ": zero or non-finite axis");
         jd.axis = axis.normalized();
       }
       if (jd.type == JointDescription::Type::kContinuous) {
@@ -233,12 +365,32 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
         }
         jd.velocity = j->limits->velocity;
         jd.effort = j->limits->effort;
+        if (!(jd.velocity >= 0.0) || !(jd.effort >= 0.0) || !std::isfinite(jd.velocity) || !std::isfinite(jd.effort))
+          fail(origin, "joint " + j->name + ": limit velocity and effort must be finite and >= 0");
       }
-      if (j->dynamics) jd.damping = j->dynamics->damping;
+      if (jd.type == JointDescription::Type::kRevolute || jd.type == JointDescription::Type::kPrismatic) {
+        // urdfdom reads a missing lower/upper as 0, so <limit> without bounds arrives here as [0, 0]
+        if (!j->limits) fail(origin, "joint " + j->name + ": a revolute or prismatic joint needs <limit>");
+        if (!std::isfinite(jd.lower) || !std::isfinite(jd.upper))
+          fail(origin, "joint " + j->name + ": limits must be finite");
+        if (!(jd.lower < jd.upper))
+          fail(origin, "joint " + j->name + ": limit lower (" + std::to_string(jd.lower) + ") must be below upper (" +
+                           std::to_string(jd.upper) + "); a missing bound reads as 0, an empty range is a fixed joint");
+      }
+      if (j->dynamics) {
+        jd.damping = j->dynamics->damping;
+        if (!(jd.damping >= 0.0) || !std::isfinite(jd.damping)) fail(origin, "joint " + j->name + ": damping must be finite and >= 0");
+      }
       if (j->mimic) {
         jd.mimic_joint = j->mimic->joint_name;
         jd.mimic_multiplier = j->mimic->multiplier;
         jd.mimic_offset = j->mimic->offset;
+        if (!std::isfinite(jd.mimic_multiplier) || !std::isfinite(jd.mimic_offset))
+          fail(origin, "joint " + j->name + ": mimic multiplier and offset must be finite");
+        const auto target = model->joints_.find(*jd.mimic_joint);
+        if (target == model->joints_.end() || !target->second || target->second->type == urdf::Joint::FIXED ||
+            target->second->mimic || *jd.mimic_joint == j->name)
+          fail(origin, "joint " + j->name + ": mimics '" + *jd.mimic_joint + "', which is not a movable, non-mimic joint");
       }
       out.joints.push_back(std::move(jd));
     }

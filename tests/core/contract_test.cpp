@@ -88,7 +88,7 @@ TEST_P(ContractValidation, RejectsWithMessage) {
 INSTANTIATE_TEST_SUITE_P(
     AllRules, ContractValidation,
     ::testing::Values(
-        BadCase{"", "contract is not valid JSON"}, BadCase{"{", "contract is not valid JSON"},
+        BadCase{"", "contract: not valid JSON"}, BadCase{"{", "contract: not valid JSON"},
         BadCase{"[1,2]", "contract must be a JSON object"},
         BadCase{BODY("[]", "[]", "[]", "\"delta\"", "\"base\"", "0", "false"), "contract must have at least one pose component"},
         BadCase{BODY(OK_PERM, "[1,1]", OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "contract component dimensions must match"},
@@ -99,8 +99,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{BODY(OK_PERM, "[1,1,1,1,1,0]", OK_SCALE, "\"delta\"", "\"base\"", "0", "false"), "sign values must be -1 or 1"},
         BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,-0.5]", "\"delta\"", "\"base\"", "0", "false"), "scale values must be finite and positive"},
         BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,0.0]", "\"delta\"", "\"base\"", "0", "false"), "scale values must be finite and positive"},
-        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,NaN]", "\"delta\"", "\"base\"", "0", "false"), "contract is not valid JSON"},
-        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,1e999]", "\"delta\"", "\"base\"", "0", "false"), "contract is not valid JSON"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,NaN]", "\"delta\"", "\"base\"", "0", "false"), "contract: scale[]: not valid JSON"},
+        BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,1e999]", "\"delta\"", "\"base\"", "0", "false"), "contract: scale[]: number out of range"},
         BadCase{BODY(OK_PERM, OK_SIGN, "[1.0,1.0,1.0,1.0,1.0,\"1\"]", "\"delta\"", "\"base\"", "0", "false"), "scale must be a list of numbers"},
         BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "1.5", "false"), "lag must be an integer"},
         BadCase{BODY(OK_PERM, OK_SIGN, OK_SCALE, "\"delta\"", "\"base\"", "true", "false"), "lag must be an integer"},

@@ -162,5 +162,17 @@ TEST(EpisodeSeed, IsAPinnedPureFunction) {
   EXPECT_EQ(seeds.size(), 400u);
 }
 
+TEST(AdapterEpisodeSeed, DependsOnlyOnSeedAndTheIndexWithinTheContract) {
+  // the contract index does not enter: a brute force over a split cannot recover it from the seed
+  EXPECT_EQ(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260718, 3));
+  EXPECT_NE(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260718, 4));
+  EXPECT_NE(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260719, 3));
+  // and it is not the environment's seed of any (contract, episode) pair of a small job
+  std::set<std::uint64_t> env_seeds;
+  for (int c = 0; c < 9; ++c)
+    for (int e = 0; e < 90; ++e) env_seeds.insert(episode_seed(20260718, c, e));
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(env_seeds.count(adapter_episode_seed(20260718, k)), 0u);
+}
+
 }  // namespace
 }  // namespace actionshift::eval

@@ -99,7 +99,7 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
   EXPECT_THAT([&] { parse_record_line(missing.dump(), "r.jsonl:9"); },
               ThrowsMessage<InputError>(HasSubstr("r.jsonl:9: return: missing field")));
   EXPECT_THAT([&] { parse_record_line(line.substr(0, 40), "r.jsonl:3"); },
-              ThrowsMessage<InputError>(HasSubstr("r.jsonl:3: malformed JSON")));
+              ThrowsMessage<InputError>(HasSubstr("r.jsonl:3: not valid JSON")));
   EXPECT_THAT([&] { parse_record_line("[1,2]", "r.jsonl:3"); },
               ThrowsMessage<InputError>(HasSubstr("expected a JSON object per line")));
 }

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -75,17 +77,25 @@ TEST_F(RunnerTest, StampsJobFieldsAndDealsEpisodesOverContracts) {
   const JobSpec job = testing::fake_job(10);
   std::mutex mu;
   std::set<std::int64_t> seen;
+  std::map<std::int64_t, std::set<std::uint64_t>> adapter_seeds;  // by index within the contract
   auto fn = [&](const EpisodeTask& t) {
     EXPECT_EQ(t.job, &job);
     EXPECT_EQ(t.contract_index, t.episode_index % 3);
     EXPECT_EQ(t.contract_episode, t.episode_index / 3);
     EXPECT_EQ(t.episode_seed, episode_seed(job.seed, t.contract_index, t.episode_index));
+    EXPECT_EQ(t.adapter_seed, adapter_episode_seed(job.seed, t.contract_episode));
     std::lock_guard lock(mu);
     seen.insert(t.episode_index);
+    adapter_seeds[t.contract_episode].insert(t.adapter_seed);
     return testing::fake_episode_fn()(t);
   };
   const auto r = run_job(job, fn, opts("x", 2));
   EXPECT_EQ(seen.size(), 10u);
+  // the adapter's seed is the same for every contract: the k-th episode of contracts 0, 1 and 2
+  // get one seed, so it tells an adapter nothing about which contract it faces
+  ASSERT_EQ(adapter_seeds.size(), 4u);  // 10 episodes over 3 contracts: within-contract indices 0..3
+  for (const auto& [k, seeds] : adapter_seeds) EXPECT_EQ(seeds.size(), 1u) << "contract episode " << k;
+  EXPECT_NE(*adapter_seeds[0].begin(), *adapter_seeds[1].begin());
   const auto file = read_record_file(r.jsonl_path);
   ASSERT_EQ(file.records.size(), 10u);
   for (std::size_t i = 0; i < 10; ++i) {
@@ -136,6 +146,40 @@ TEST_F(RunnerTest, FailingEpisodeKeepsEarlierRecordsAndResumes) {
   EXPECT_EQ(r.episodes_run, 13);
   const auto ref = run_job(job, testing::fake_episode_fn(), opts("ref", 1));
   EXPECT_EQ(slurp(path), slurp(ref.jsonl_path));
+}
+
+// a full disk (here: a file-size limit) fails the JSONL append first; the summary written afterwards
+// fails too, and its error must not hide the first one
+TEST_F(RunnerTest, FirstIoErrorIsTheOneReported) {
+  const JobSpec job = testing::fake_job(40);
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(fds[0]);
+    ::signal(SIGXFSZ, SIG_IGN);  // writes past the limit fail with EFBIG instead of killing the process
+    const rlimit limit{600, 600};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::string message = "no error";
+    try {
+      run_job(job, testing::fake_episode_fn(), opts("full", 1));
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+    const ssize_t n = ::write(fds[1], message.data(), message.size());
+    ::_exit(n > 0 ? 0 : 1);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buf[512];
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) message.append(buf, static_cast<std::size_t>(n));
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_THAT(message, HasSubstr(job_id(job) + ".jsonl: write failed"));
+  EXPECT_THAT(message, ::testing::Not(HasSubstr("summary")));
 }
 
 TEST_F(RunnerTest, InvalidRecordFromEpisodeFunctionStopsTheJob) {

@@ -38,7 +38,7 @@ class StoreTest : public ::testing::Test {
   static EpisodeRecord record(const JobSpec& job, std::int64_t i) {
     const auto slot = episode_slot(job.split.contracts, i);
     EpisodeTask t{&job, job.seed, slot.contract_index, slot.contract_episode, i,
-                  episode_seed(job.seed, slot.contract_index, i), 0};
+                  episode_seed(job.seed, slot.contract_index, i), adapter_episode_seed(job.seed, slot.contract_episode), 0};
     EpisodeRecord r = testing::fake_episode_fn()(t);
     r.job_id = job_id(job);
     r.task = job.task;
@@ -134,7 +134,7 @@ TEST_F(StoreTest, CorruptMiddleLineIsAnErrorAndTheFileIsUntouched) {
     f << bytes << "{\"torn";  // plus a torn tail that must NOT be repaired when failing
   }
   EXPECT_THAT([&] { ResultStore::open(dir_.string(), job); },
-              ThrowsMessage<InputError>(HasSubstr(path + ":2: malformed JSON")));
+              ThrowsMessage<InputError>(HasSubstr(path + ":2: not valid JSON")));
   EXPECT_EQ(slurp(path), bytes + "{\"torn");
 }
 

@@ -87,7 +87,7 @@ TEST(Summary, LoadsEveryJsonlOfADirectory) {
     std::ofstream f(dir / "a.jsonl", std::ios::app);
     f << "not json\n" << to_jsonl_line(a[0]) << "\n";
   }
-  EXPECT_THAT([&] { load_results(dir.string()); }, ThrowsMessage<InputError>(HasSubstr("a.jsonl:4: malformed JSON")));
+  EXPECT_THAT([&] { load_results(dir.string()); }, ThrowsMessage<InputError>(HasSubstr("a.jsonl:4: not valid JSON")));
   EXPECT_THAT([&] { load_results((dir / "nope").string()); }, ThrowsMessage<InputError>(HasSubstr("not a results directory")));
   std::filesystem::remove_all(dir);
 }

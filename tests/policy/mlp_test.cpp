@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -55,6 +57,36 @@ TEST(MlpFormat, TruncatedCorruptAndWrongShapeAreOneLineErrors) {
   relabel.replace(at, 18, "\"task\":\"push_cube\"");
   expect_input_error([&] { policy::parse_mlp(relabel, "w.asmlp"); }, "input size 42 does not match task push_cube (expected 35)");
   expect_input_error([] { policy::load_mlp("/nonexistent/w.asmlp"); }, "/nonexistent/w.asmlp: cannot open weight file");
+}
+
+// the header's text replaced (its length field rewritten), as a hostile writer would
+std::string with_header_edit(const std::string& bytes, const std::string& from, const std::string& to) {
+  std::uint32_t hlen = 0;
+  std::memcpy(&hlen, bytes.data() + 12, 4);
+  std::string header = bytes.substr(16, hlen);
+  const auto at = header.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) header.replace(at, from.size(), to);
+  const auto n = static_cast<std::uint32_t>(header.size());
+  std::string out = bytes.substr(0, 12);
+  out.append(reinterpret_cast<const char*>(&n), 4);
+  return out + header + bytes.substr(16 + hlen);
+}
+
+TEST(MlpFormat, HostileHeaderNumbersAreOneLineErrors) {
+  const std::string bytes = policy::serialize_mlp(small_net(sim::TaskId::kPickCube));
+  // 1e30 does not fit an int: an error, not an undefined float-to-int conversion
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"history\":0", "\"history\":1e30"), "w.asmlp"); },
+                     "w.asmlp: header.history: expected an integer in the range of int (got 1e+30)");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"history\":0", "\"history\":2.5"), "w.asmlp"); },
+                     "header.history: expected an integer");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"history\":0", "\"history\":1e999"), "w.asmlp"); },
+                     "w.asmlp: header.history: number out of range");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"layers\":[", "\"layers\":[4294967338,"), "w.asmlp"); },
+                     "header.layers: expected an integer");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"history\":0", "\"history\":" + std::string(100, '[') + std::string(100, ']')), "w.asmlp"); },
+                     "nested deeper than 64 levels");
+  expect_input_error([] { policy::load_mlp(std::filesystem::temp_directory_path().string()); }, "is a directory");
 }
 
 TEST(MlpPolicy, HistoryHoldsTheLastFourActionsMostRecentFirst) {

@@ -4,6 +4,7 @@
 #include "actionshift/core/manifest.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/core/rng.hpp"
+#include "oracle_access.hpp"  // src/eval: the runner's factory of the oracle view
 
 #include <gtest/gtest.h>
 
@@ -50,6 +51,10 @@ static_assert(!has_contract_json<HiddenContractEnv>::value, "the agent side must
 static_assert(!std::is_copy_constructible_v<HiddenContractEnv>);
 // the idiom does detect the accessor where it exists
 static_assert(has_contract<OracleRecorder>::value && has_contract_json<OracleRecorder>::value);
+// only the runner's factory can construct the oracle's view (oracle_view_negative.cpp proves the
+// same by failing to compile)
+static_assert(!std::is_constructible_v<OracleRecorder, const HiddenContractEnv&>);
+static_assert(!std::is_default_constructible_v<OracleRecorder::Key>);
 
 TEST(HiddenContractEnv, PublicInterfaceIsObservationsInRawActionsOut) {
   static_assert(std::is_same_v<decltype(std::declval<HiddenContractEnv&>().reset(std::uint64_t{})), const Eigen::VectorXd&>);
@@ -82,7 +87,7 @@ TEST(HiddenContractEnv, OracleEncodeThenWrapperDecodeReproducesTheCanonicalActio
   for (FrameRotation rot : {FrameRotation::kLiveTcp, FrameRotation::kIdentity}) {
     for (std::size_t ci = 0; ci < contracts.size(); ++ci) {
       HiddenContractEnv env(model, contracts[ci], rot);
-      const OracleRecorder oracle(env);
+      const OracleRecorder oracle = eval::detail::OracleAccess::view(env);
       EXPECT_EQ(oracle.contract_json(), contracts[ci].to_json());
       env.reset(100 + ci);
       Rng rng(ci);
@@ -129,7 +134,7 @@ TEST(HiddenContractEnv, ToolFrameUsesTheLiveTcpOrientationUnlessIdentityMode) {
   HiddenContractEnv live(model, tool, FrameRotation::kLiveTcp), flat(model, tool, FrameRotation::kIdentity);
   live.reset(2);
   flat.reset(2);
-  const OracleRecorder ol(live), of(flat);
+  const OracleRecorder ol = eval::detail::OracleAccess::view(live), of = eval::detail::OracleAccess::view(flat);
   const Mat3 r = ol.frame_rotation();
   EXPECT_NEAR(r.col(2).z(), -1.0, 0.05);  // hand points down at rest
   EXPECT_TRUE(of.frame_rotation().isIdentity());
@@ -145,7 +150,7 @@ TEST(HiddenContractEnv, RawNanSixElementAndHugeActionsEndTheEpisodeWithAFlag) {
   const auto model = EnvModel::make(TaskId::kPickCube);
   for (const Contract& c : representative_contracts("unseen_composition")) {
     HiddenContractEnv env(model, c);
-    const OracleRecorder oracle(env);
+    const OracleRecorder oracle = eval::detail::OracleAccess::view(env);
     auto run = [&](std::vector<double> raw) {
       env.reset(6);
       env.step(oracle.encode(Action::Zero()));

@@ -2,6 +2,7 @@
 #include "actionshift/sim/robot_description.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/sim/kinematics.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -33,7 +34,8 @@ TEST(PandaDescription, ChainLimitsAndMasses) {
   EXPECT_NEAR(mass, 17.45, 0.01);  // total of the published identified inertial set (docs/reference.md, Panda and tasks)
   // four collision boxes per finger
   EXPECT_EQ(p.links[static_cast<std::size_t>(p.link_index("panda_leftfinger"))].collisions.size(), 4u);
-  EXPECT_THROW(p.link_index("nope"), std::out_of_range);
+  EXPECT_THAT([&] { p.link_index("nope"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("no link named 'nope'")));
+  EXPECT_THAT([&] { p.joint_index("nope"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("no joint named 'nope'")));
 }
 
 class UrdfFiles : public ::testing::Test {
@@ -115,6 +117,129 @@ TEST_F(UrdfFiles, UnreadableMeshAndUnknownPackageAndBadXml) {
   EXPECT_THAT([&] { load_urdf_file(dir_ / "xml.urdf"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("xml.urdf")));
   EXPECT_THAT([&] { load_urdf_file(dir_ / "does_not_exist.urdf"); },
               ::testing::ThrowsMessage<InputError>(HasSubstr("does_not_exist.urdf")));
+}
+
+// ---- hostile robot descriptions: every one is a one-line InputError naming the file, never a crash
+
+std::string panda_with(const std::string& before, const std::string& after) {
+  std::string text(panda_urdf_text());
+  const auto at = text.find(before);
+  EXPECT_NE(at, std::string::npos) << before;
+  if (at != std::string::npos) text.replace(at, before.size(), after);
+  return text;
+}
+
+std::string rejection(const std::string& xml) {
+  try {
+    parse_urdf(xml, ".", {}, "hostile.urdf");
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("hostile.urdf: ", 0), 0u) << what;
+    return what;
+  }
+  ADD_FAILURE() << "accepted";
+  return {};
+}
+
+TEST(HostileUrdf, KinematicLoopIsRejectedNotARecursionOverflow) {
+  const std::string loop = panda_with("</robot>", R"(<joint name="loop" type="fixed"><parent link="panda_link7"/><child link="panda_link1"/></joint></robot>)");
+  EXPECT_THAT(rejection(loop), HasSubstr("kinematic loop"));
+}
+
+TEST(HostileUrdf, UrdfdomsOwnReasonIsInTheMessage) {
+  // a revolute joint without <limit>: urdfdom refuses it and says why
+  const std::string no_limit = panda_with(R"(<limit lower="-2.8973" upper="2.8973" velocity="2.1750" effort="87"/><dynamics damping="0.003"/>
+  </joint>
+  <joint name="panda_joint2")", R"(</joint>
+  <joint name="panda_joint2")");
+  EXPECT_THAT(rejection(no_limit), HasSubstr("limits"));
+  EXPECT_THAT(rejection(panda_with(R"(<child link="panda_link2"/>)", R"(<child link="panda_link_nowhere"/>)")),
+              HasSubstr("panda_link_nowhere"));
+  EXPECT_THAT(rejection(panda_with("</robot>", R"(<link name="island"/></robot>)")), HasSubstr("root"));
+  const std::string truncated(panda_urdf_text().substr(0, panda_urdf_text().size() / 2));
+  EXPECT_THAT(rejection(truncated), HasSubstr("not a valid URDF: "));
+  EXPECT_THAT(rejection(truncated), ::testing::Not(HasSubstr("urdfdom could not parse it")));
+}
+
+TEST(HostileUrdf, NonFiniteOriginIsRejected) {
+  EXPECT_THAT(rejection(panda_with(R"(<parent link="panda_link0"/><child link="panda_link1"/>)",
+                                   R"(<parent link="panda_link0"/><child link="panda_link1"/><origin xyz="0 nan 0"/>)")),
+              ::testing::AnyOf(HasSubstr("origin"), HasSubstr("nan")));
+}
+
+TEST(HostileUrdf, PhysicallyInvalidLimitsAndInertiasAreRejected) {
+  EXPECT_THAT(rejection(panda_with(R"(lower="-3.0718" upper="-0.0698")", R"(lower="-0.0698" upper="-3.0718")")),
+              HasSubstr("panda_joint4: limit lower"));
+  // <limit> without bounds: urdfdom defaults both to 0
+  EXPECT_THAT(rejection(panda_with(R"(lower="-3.0718" upper="-0.0698" )", "")), HasSubstr("panda_joint4: limit lower"));
+  EXPECT_THAT(rejection(panda_with(R"(velocity="2.1750" effort="87"/>)", R"(velocity="-1" effort="87"/>)")), HasSubstr("velocity"));
+  const std::string toy = R"(<robot name="toy"><link name="a"/><link name="b"><inertial><mass value="1"/>
+    <inertia ixx="INERTIA" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+    <joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)";
+  const auto with_ixx = [&](const std::string& v) { std::string t = toy; t.replace(t.find("INERTIA"), 7, v); return t; };
+  EXPECT_NO_THROW(parse_urdf(with_ixx("0.01"), "."));
+  EXPECT_THAT(rejection(with_ixx("-0.01")), HasSubstr("link b: inertia is not positive semi-definite"));
+  EXPECT_THAT(rejection(with_ixx("0.05")), HasSubstr("triangle inequality"));
+  std::string mass = with_ixx("0.01");
+  mass.replace(mass.find(R"(value="1")"), 9, R"(value="-1")");
+  EXPECT_THAT(rejection(mass), HasSubstr("mass"));
+}
+
+TEST(HostileUrdf, DeepXmlAndUnknownMimicAreRejected) {
+  std::string deep = "<robot name='x'>";
+  for (int i = 0; i < 100000; ++i) deep += "<a>";
+  EXPECT_THAT(rejection(deep), HasSubstr("nested deeper"));
+  EXPECT_THAT(rejection(panda_with(R"(<mimic joint="panda_finger_joint1")", R"(<mimic joint="panda_ghost")")), HasSubstr("panda_ghost"));
+}
+
+TEST(HostileUrdf, MissingTcpLinkIsTheProjectsInputError) {
+  EXPECT_THAT([] { KinematicChain(panda_description(), "panda_tcp_nowhere"); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("panda_tcp_nowhere")));
+}
+
+TEST_F(UrdfFiles, ColladaMeshHasTheBoundsOfItsStlTwin) {
+  // one asymmetric tetrahedron, written as binary-free ASCII STL and as a Z_UP Collada file
+  const double v[4][3] = {{0.0, 0.0, 0.0}, {0.1, 0.0, 0.0}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.3}};
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  std::string stl = "solid t\n";
+  for (const auto& t : f) {
+    stl += "facet normal 0 0 0\nouter loop\n";
+    for (int k : t) stl += "vertex " + std::to_string(v[k][0]) + " " + std::to_string(v[k][1]) + " " + std::to_string(v[k][2]) + "\n";
+    stl += "endloop\nendfacet\n";
+  }
+  stl += "endsolid t\n";
+  write(dir_ / "meshes" / "t.stl", stl);
+  std::string pos, idx;
+  for (const auto& p : v) pos += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + " ";
+  for (const auto& t : f) idx += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " ";
+  write(dir_ / "meshes" / "t.dae", R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="g" name="g"><mesh>
+    <source id="g-pos"><float_array id="g-pos-array" count="12">)" + pos + R"(</float_array>
+      <technique_common><accessor source="#g-pos-array" count="4" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+    <vertices id="g-vtx"><input semantic="POSITION" source="#g-pos"/></vertices>
+    <triangles count="4"><input semantic="VERTEX" source="#g-vtx" offset="0"/><p>)" + idx + R"(</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node id="n" name="n"><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)");
+  const auto bounds = [&](const std::string& mesh) {
+    write(dir_ / "m.urdf", urdf(mesh, "meshes/box.obj"));
+    const RobotDescription d = load_urdf_file(dir_ / "m.urdf");
+    const auto& g = d.links[static_cast<std::size_t>(d.link_index("base"))].collisions.at(0);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+    for (const auto& p : g.mesh->vertices) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
+    return std::pair{lo, hi};
+  };
+  const auto [stl_lo, stl_hi] = bounds("meshes/t.stl");
+  const auto [dae_lo, dae_hi] = bounds("meshes/t.dae");
+  EXPECT_TRUE(stl_hi.isApprox(Eigen::Vector3d(0.2, 0.4, 0.6), 1e-6)) << stl_hi.transpose();  // scale 2
+  EXPECT_TRUE(dae_lo.isApprox(stl_lo, 1e-6) || (dae_lo - stl_lo).norm() < 1e-9) << dae_lo.transpose() << " vs " << stl_lo.transpose();
+  EXPECT_TRUE(dae_hi.isApprox(stl_hi, 1e-6)) << dae_hi.transpose() << " vs " << stl_hi.transpose();
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/types.hpp"
 
 #include <nlohmann/json.hpp>
@@ -144,11 +145,10 @@ class Contract {
     return make(f);
   }
 
-  /// Parses JSON text; a syntax error becomes std::invalid_argument("contract is not valid JSON: …").
+  /// Parses JSON text; a syntax error, nesting deeper than kMaxJsonDepth or a number outside a
+  /// double's range becomes an InputError (a std::invalid_argument) "contract: <field>: <reason>".
   static Contract from_json(std::string_view text) {
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (j.is_discarded()) throw std::invalid_argument("contract is not valid JSON");
-    return from_json_value(j);
+    return from_json_value(parse_json_input(text, "contract"));
   }
 
   /// The JSON object form (keys sorted by nlohmann's std::map).

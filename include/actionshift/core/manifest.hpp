@@ -13,6 +13,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/grammar.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/core/rng.hpp"
 
@@ -71,8 +72,7 @@ class Manifest {
   /// Parses a manifest file's text. Throws InputError(source, field, reason) for malformed
   /// structure or an invalid contract. Hashes are NOT checked here: see validate().
   static Manifest parse(std::string_view text, const std::string& source) {
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
+    const nlohmann::json j = parse_json_input(text, source);
     if (!j.is_object()) throw InputError(source, "", "manifest must be a JSON object");
     auto str = [&](const char* k) -> std::string {
       if (!j.contains(k)) throw InputError(source, k, "missing field");

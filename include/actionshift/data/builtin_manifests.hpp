@@ -16,8 +16,9 @@ std::vector<std::string> builtin_manifest_names();
 /// The exact file text of a built-in manifest, or nullopt.
 std::optional<std::string_view> builtin_manifest_text(std::string_view name);
 
-/// Resolves a split or pool: an existing file path is loaded from disk; otherwise a built-in
-/// name. Throws InputError naming the argument and listing the built-in names if neither.
+/// Resolves a split or pool: an existing file path is loaded from disk and its stored hashes are
+/// verified (record_hashes, manifest_hash, pool_hash: a failure is InputError(path, check name, …));
+/// otherwise a built-in name. Throws InputError naming the argument and listing the built-in names if neither.
 Manifest resolve_manifest(const std::string& name_or_path);
 
 /// The exact text of the committed response calibration of a task on a simulator fidelity profile

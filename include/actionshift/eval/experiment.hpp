@@ -7,6 +7,7 @@
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
+#include "actionshift/policy/external.hpp"
 
 #include <optional>
 #include <string>
@@ -26,6 +27,11 @@ adapt::ResponseCalibration builtin_calibration(const std::string& task, const st
 /// what enters the job spec, so a changed default changes the job id.
 std::string resolved_method_params(const std::string& method, const std::string& params_json = "{}");
 
+/// Run-time options of an episode function that do not change results (and so stay out of the job id).
+struct EpisodeFnOptions {
+  policy::ExternalOptions external;  ///< timeouts of an external:<command> backbone (run --step-timeout)
+};
+
 /// The episode function of `job`. Resolves every name and checks that the split manifest hash, pool
 /// hash, calibration hash and backbone hash equal the spec's (a stale plan is an InputError, never
 /// a silent mismatch). The function is thread-safe: each runner worker gets its own environments,
@@ -35,6 +41,6 @@ std::string resolved_method_params(const std::string& method, const std::string&
 /// canonical intent goes through adapter.encode (frame rotation from the observed TCP quaternion in
 /// `live` mode, identity otherwise), the env steps the raw action, and the adapter observes the TCP
 /// response. Episodes run the full horizon (success does not end them) unless a safety check fires.
-EpisodeFn make_episode_fn(const JobSpec& job);
+EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options = {});
 
 }  // namespace actionshift::eval

@@ -141,4 +141,12 @@ std::uint64_t splitmix64(std::uint64_t x) noexcept;
 /// same initial states for the same (seed, contract index, episode index).
 std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept;
 
+/// The seed handed to the adapter (Adapter::begin_episode): splitmix64(splitmix64(seed ^ D) ^
+/// contract_episode) with a fixed domain constant D. It depends only on the job's seed and the
+/// episode's index *within* its contract, so it is the same for every contract of the split: an
+/// adapter cannot invert it to the contract index, and the dealing order (which episode index of
+/// the job ran which contract) is not in it. (episode_seed, which also fixes the initial state,
+/// stays with the environment.)
+std::uint64_t adapter_episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept;
+
 }  // namespace actionshift::eval

@@ -20,7 +20,8 @@ struct EpisodeTask {
   std::int64_t contract_index{0};     ///< contract of the split (episode_index mod contracts)
   std::int64_t contract_episode{0};   ///< index of this episode within its contract
   std::int64_t episode_index{0};      ///< index of the episode within the job
-  std::uint64_t episode_seed{0};      ///< episode_seed(seed, contract_index, episode_index)
+  std::uint64_t episode_seed{0};      ///< episode_seed(seed, contract_index, episode_index): the environment's
+  std::uint64_t adapter_seed{0};      ///< adapter_episode_seed(seed, contract_episode): the only seed an adapter gets
   unsigned worker{0};                 ///< worker thread index in [0, threads): key per-worker state on it
 };
 

@@ -17,7 +17,10 @@
 /// when the policy is constructed (one process per clone, so one per worker thread). A process
 /// that exits, closes stdout, exceeds the timeout, or replies with anything but a JSON object with
 /// a 7-number finite "action" array makes act() throw std::runtime_error naming the command, the
-/// step and the reason; nothing hangs. SIGPIPE is ignored process-wide once an external policy is
+/// step and the reason; nothing hangs: writing a request and waiting for its reply are both bounded
+/// by the step timeout (the hello's by the hello timeout). The protocol is strictly one reply line
+/// per step request: a second reply line, a reply to a reset, or output while a request is still
+/// being written is a protocol error (a flooding process cannot make replies lag requests). SIGPIPE is ignored process-wide once an external policy is
 /// created (writes to a dead process then fail with EPIPE instead of killing the caller).
 
 #include "actionshift/policy/policy.hpp"
@@ -25,6 +28,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace actionshift::policy {
 
@@ -36,6 +40,13 @@ struct ExternalOptions {
   double hello_timeout_s{30.0};  ///< process start-up until the "ready" reply
   double step_timeout_s{10.0};   ///< one step request until its reply
 };
+
+/// One reply line to a step request: a JSON object with a 7-number finite "action" array (nesting
+/// beyond kMaxJsonDepth, numbers outside a double's range and anything else are rejected).
+/// throws std::invalid_argument(reason). Used by ExternalPolicy::act; public for tests and fuzzing.
+Action parse_step_reply(std::string_view reply);
+/// True for the hello's reply {"type":"ready"} (other keys ignored).
+bool is_ready_reply(std::string_view reply);
 
 /// The external-process policy (name "external:<command>", sha256 = SHA-256 of the command string).
 class ExternalPolicy final : public Policy {
@@ -56,8 +67,10 @@ class ExternalPolicy final : public Policy {
 
  private:
   struct Process;
-  void send(const std::string& line, const char* what);
+  void send(const std::string& line, const char* what, double timeout_s);
   std::string receive(double timeout_s, const char* what);
+  bool read_some(const char* what);
+  void check_no_pending_output(const char* what);
   [[noreturn]] void fail(const std::string& what, const std::string& reason);
 
   std::string command_;

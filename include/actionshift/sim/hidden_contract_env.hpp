@@ -14,6 +14,10 @@
 #include <span>
 #include <string>
 
+namespace actionshift::eval::detail {
+struct OracleAccess;  // the runner's factory of the oracle's view (src/eval/oracle_access.hpp, not installed)
+}
+
 namespace actionshift::sim {
 
 namespace detail {
@@ -56,10 +60,20 @@ class HiddenContractEnv {
 };
 
 /// Evaluation-only view of a HiddenContractEnv: the contract and what the oracle needs to encode.
-/// Only the runner constructs it (never hand it to an adapter other than the oracle).
+/// Only the runner constructs it: the constructor takes a passkey whose constructor is private to
+/// eval::detail::OracleAccess (the runner's factory, in a header that is not installed), so code
+/// holding the agent-facing environment cannot build the view. tests/sim/oracle_view_negative.cpp
+/// is compiled by CTest and must fail to compile. (C++ cannot stop a translation unit that
+/// redefines the befriended class, an ODR violation; every well-formed path is closed.)
 class OracleRecorder {
  public:
-  explicit OracleRecorder(const HiddenContractEnv& env) : env_(&env) {}
+  /// The passkey: only eval::detail::OracleAccess can make one.
+  class Key {
+    Key() {}  // user-provided and private: no aggregate or value-initialisation route around it
+    friend struct ::actionshift::eval::detail::OracleAccess;
+  };
+
+  OracleRecorder(const HiddenContractEnv& env, Key) : env_(&env) {}
 
   const Contract& contract() const;
   std::string contract_json() const;      ///< canonical JSON (hash input)

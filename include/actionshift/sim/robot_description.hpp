@@ -66,9 +66,9 @@ struct RobotDescription {
   std::vector<LinkDescription> links;
   std::vector<JointDescription> joints;
 
-  /// Index of a link by name; throws std::out_of_range naming it if absent.
+  /// Index of a link by name; throws actionshift::InputError naming the robot and the link if absent.
   int link_index(std::string_view link) const;
-  /// Index of a joint by name; throws std::out_of_range naming it if absent.
+  /// Index of a joint by name; throws actionshift::InputError naming the robot and the joint if absent.
   int joint_index(std::string_view joint) const;
   /// Joint whose child is `link`, or -1 for the root.
   int parent_joint(int link) const;
@@ -82,8 +82,14 @@ using PackageMap = std::map<std::string, std::filesystem::path>;
 /// Parse a URDF file. Relative mesh paths resolve against the file's directory,
 /// `package://` through `packages`, `file://` as absolute paths. Meshes are loaded (and
 /// cached per process) through assimp.
-/// throws actionshift::InputError (what() = "<urdf file>: <reason naming the mesh>") on any failure:
-/// unreadable URDF, bad XML, unsupported joint type, unknown package, missing or unreadable mesh.
+/// throws actionshift::InputError (what() = "<urdf file>: <reason>", one line) on any failure:
+/// unreadable URDF, bad XML (urdfdom's own reason is included), XML nested deeper than 64 levels,
+/// a link reached twice (kinematic loop) or not connected to the root, unsupported joint type,
+/// a revolute/prismatic joint without <limit> or with lower >= upper, negative or non-finite
+/// velocity/effort/damping, a non-physical inertia (negative mass, not positive semi-definite, or
+/// violating the triangle inequality), non-finite origins or axes, a mimic of a joint that is not a
+/// movable non-mimic joint, unknown package, missing or unreadable mesh. Collada meshes are read in
+/// their own coordinates (the file's <up_axis> is not applied), like STL and OBJ.
 RobotDescription load_urdf_file(const std::filesystem::path& urdf, const PackageMap& packages = {});
 
 /// Parse URDF text; `base_dir` resolves relative mesh paths, `origin_name` names the source in errors.

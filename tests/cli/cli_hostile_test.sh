@@ -1,0 +1,144 @@
+#!/usr/bin/env bash
+# Hostile input at the CLI boundary: every case must end in one `actionshift: error:` line and exit 2
+# (3 for selftest), never a crash, a hang, a raw library message or a leftover temporary file.
+# Fast: no case runs more than a handful of simulated episodes.
+set -euo pipefail
+AS="$1"
+SRC="$2"
+source "$(dirname "$0")/lib.sh"
+
+deep() { python3 -c "import sys; n=int(sys.argv[1]); sys.stdout.write('['*n + ']'*n)" "$1"; }
+
+# ---- deeply nested JSON: a plan's method parameters, a manifest's metadata, a JSONL record field
+python3 - "$TMP" <<'PY'
+import sys
+d = sys.argv[1]
+deep = '[' * 100000 + ']' * 100000
+open(d + '/deep_plan.json', 'w').write('{"schema_version":"1","jobs":[{"method":{"params":' + deep + '}}]}')
+PY
+cp "$SRC/manifests/reference_seen.json" "$TMP/deep_manifest.json"
+python3 - "$TMP/deep_manifest.json" <<'PY'
+import sys
+p = sys.argv[1]
+t = open(p).read()
+t = t.replace('"metadata": {}', '"metadata": {"x": ' + '[' * 100000 + ']' * 100000 + '}', 1)
+open(p, 'w').write(t)
+PY
+run "$AS" run --plan "$TMP/deep_plan.json" --out "$TMP/o" --progress off
+expect_rc 2 "deep plan"
+expect_one_line_error "deep plan"
+expect_err "nested deeper than" "deep plan"
+run "$AS" validate "$TMP/deep_manifest.json"
+expect_rc 2 "deep manifest"
+expect_one_line_error "deep manifest"
+expect_err "metadata" "deep manifest names the field"
+
+# ---- a small real job, then hostile edits of its JSONL
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/r" --progress off
+expect_rc 0 "small job"
+JL=$(ls "$TMP"/r/*.jsonl)
+cp "$JL" "$TMP/clean.jsonl"
+mkdir -p "$TMP/deep" "$TMP/ovf"
+python3 - "$JL" "$TMP/deep/a.jsonl" "$TMP/ovf/a.jsonl" <<'PY'
+import sys
+src, deep, ovf = sys.argv[1:4]
+lines = open(src).read().splitlines()
+first = lines[0]
+open(deep, 'w').write(first[:-1] + ',"x":' + '[' * 100000 + ']' * 100000 + '}\n')
+import re
+open(ovf, 'w').write(re.sub(r'"task_return":[^,}]+', '"task_return":1e999', first) + '\n')
+PY
+run "$AS" summarize --results "$TMP/deep"
+expect_rc 2 "deep record"
+expect_one_line_error "deep record"
+run "$AS" summarize --results "$TMP/ovf"
+expect_rc 2 "overflowing record"
+expect_one_line_error "overflowing record"
+expect_err "task_return" "overflowing record names the field"
+expect_err "out of range" "overflowing record says why"
+# a resume repairs a last record that ends in 1e999 (a torn write), with nothing else lost
+python3 - "$JL" <<'PY'
+import re, sys
+p = sys.argv[1]
+lines = open(p).read().splitlines()
+lines[-1] = re.sub(r'"backbone_sha256":"[0-9a-f]*"', '"backbone_sha256":1e999', lines[-1])
+open(p, 'w').write('\n'.join(lines) + '\n')
+PY
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/r" --progress off
+expect_rc 0 "resume over a 1e999 record"
+expect_err "repaired a torn last line" "resume logs the repair"
+cmp -s "$JL" "$TMP/clean.jsonl" && ok || bad "the repaired JSONL differs from the clean run"
+
+# ---- run --split FILE verifies the stored hashes; the clean copy still runs
+sed 's/"scale": \[1.0/"scale": [0.5/' "$SRC/manifests/reference_seen.json" > "$TMP/tampered.json"
+cmp -s "$TMP/tampered.json" "$SRC/manifests/reference_seen.json" && bad "tamper did not change the file" || ok
+run "$AS" run --task pick_cube --split "$TMP/tampered.json" --method oracle --episodes 1 --out "$TMP/tam" --progress off
+expect_rc 2 "tampered split"
+expect_one_line_error "tampered split"
+expect_err "_hash" "tampered split names the failed check"
+[ ! -e "$TMP/tam" ] || [ -z "$(ls -A "$TMP/tam")" ] && ok || bad "tampered split wrote results"
+
+# ---- output paths are checked before any work
+touch "$TMP/afile"
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --out "$TMP/afile" --progress off
+expect_rc 2 "run --out FILE"
+expect_one_line_error "run --out FILE"
+expect_err "not a directory" "run --out FILE"
+mkdir -p "$TMP/outdir"
+run "$AS" calibrate --task pick_cube --episodes 1 --steps 2 --out "$TMP/outdir"
+expect_rc 2 "calibrate --out DIR"
+expect_one_line_error "calibrate --out DIR"
+[ -z "$(ls -A "$TMP" | grep '\.tmp' || true)" ] && ok || bad "calibrate left a .tmp behind: $(ls "$TMP")"
+run "$AS" gate0 --backbone "mlp:$TMP/outdir" --task pick_cube --episodes 1
+expect_rc 2 "gate0 mlp:DIR"
+expect_one_line_error "gate0 mlp:DIR"
+expect_err "directory" "gate0 mlp:DIR"
+
+# ---- an oversized experiment file is refused before it is read
+head -c 2000000 /dev/zero | tr '\0' 'a' > "$TMP/big.yaml"
+run "$AS" plan --experiment "$TMP/big.yaml" --out "$TMP/bigplan"
+expect_rc 2 "oversized YAML"
+expect_one_line_error "oversized YAML"
+expect_err "too large" "oversized YAML"
+printf 'name: x\nmethods: %s\n' "$(deep 100000)" > "$TMP/deep.yaml"
+run "$AS" plan --experiment "$TMP/deep.yaml" --out "$TMP/deepplan"
+expect_rc 2 "deep YAML"
+expect_one_line_error "deep YAML"
+
+# ---- selftest contract arguments: bad input is exit 3, one line
+run "$AS" selftest --expected "$(deep 100000)"
+expect_rc 3 "selftest deep contract"
+expect_one_line_error "selftest deep contract"
+run "$AS" selftest --expected "reference_seen:99999999999999999999999"
+expect_rc 3 "selftest huge index"
+expect_one_line_error "selftest huge index"
+
+# ---- an external policy that floods replies ends the job with a protocol error, quickly
+cat > "$TMP/flood.py" <<'PY'
+import sys
+for line in sys.stdin:
+    if '"hello"' in line:
+        print('{"type":"ready"}', flush=True)
+    elif '"step"' in line:
+        for _ in range(50):
+            sys.stdout.write('{"action":[0,0,0,0,0,0,0]}\n')
+        sys.stdout.flush()
+PY
+start=$(date +%s)
+run timeout 60 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --threads 1 \
+  --backbone "external:python3 $TMP/flood.py" --step-timeout 5 --out "$TMP/flood" --progress off
+expect_rc 2 "flooding policy"
+expect_err "protocol error" "flooding policy"
+[ $(( $(date +%s) - start )) -lt 30 ] && ok || bad "flooding policy took too long"
+cat > "$TMP/mute.py" <<'PY'
+import sys, time
+sys.stdin.readline()
+print('{"type":"ready"}', flush=True)
+time.sleep(60)
+PY
+run timeout 60 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --threads 1 \
+  --backbone "external:python3 $TMP/mute.py" --step-timeout 0.5 --out "$TMP/mute" --progress off
+expect_rc 2 "a policy that stops reading"
+expect_err "timeout" "a policy that stops reading"
+
+finish
