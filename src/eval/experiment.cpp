@@ -86,6 +86,7 @@ struct Context {
   std::unique_ptr<policy::Policy> prototype;
   nlohmann::json params;
   sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
+  EpisodeHooks hooks;  // default: the runner's episodes, unobserved
 
   std::mutex mutex;
   std::map<unsigned, std::unique_ptr<Worker>> workers;
@@ -103,7 +104,7 @@ struct Context {
   EpisodeRecord run(const EpisodeTask& t) {
     Worker& w = worker(t.worker);
     const auto ci = static_cast<std::size_t>(t.contract_index);
-    const Contract& truth = contracts.at(ci);
+    const Contract& truth = hooks.contract_override ? *hooks.contract_override : contracts.at(ci);
     auto it = w.envs.find(t.contract_index);
     if (it == w.envs.end()) it = w.envs.emplace(t.contract_index, sim::HiddenContractEnv(model, truth, rotation)).first;
     sim::HiddenContractEnv& env = it->second;
@@ -119,12 +120,18 @@ struct Context {
     adapter->begin_episode(t.episode_seed);
     EpisodeRecord rec;
     rec.contract_sha256 = truth.sha256();
+    const sim::OracleRecorder view(env);
+    auto show = [&](int step, bool probe) {
+      if (hooks.observer) hooks.observer(EpisodeStepView{step, env.horizon(), probe, &env.last(), &view.env()});
+    };
+    show(0, false);
     for (int step = 0; step < env.horizon(); ++step) {
       const Action intent = w.policy->act(obs);
       const Mat3 R = rotation == sim::FrameRotation::kIdentity ? Mat3::Identity() : adapt::tcp_rotation(obs, slice);
       const Action raw = adapter->encode(intent, R);
       const bool probe = adapter->last_step().probe;
       const sim::StepResult& r = env.step(raw);
+      show(step + 1, probe);
       if (r.safety != sim::SafetyFlag::kNone) break;  // the episode ended by a safety check
       const Pose6 response_now = adapt::tcp_response(obs, r.obs, slice);
       if (probe) {
@@ -147,10 +154,13 @@ struct Context {
 
 }  // namespace
 
-EpisodeFn make_episode_fn(const JobSpec& job) {
+EpisodeFn make_episode_fn(const JobSpec& job) { return make_episode_fn(job, EpisodeHooks{}); }
+
+EpisodeFn make_episode_fn(const JobSpec& job, EpisodeHooks hooks) {
   validate_job(job);
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
+  ctx->hooks = std::move(hooks);
   const sim::TaskId task = sim::parse_task(job.task);
   ctx->model = sim::EnvModel::make(task);
   ctx->slice = tcp_slice(ctx->model->layout());
