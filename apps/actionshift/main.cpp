@@ -2,6 +2,7 @@
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
 #include "cmd_policy.hpp"
+#include "cmd_render.hpp"
 #include "cmd_run.hpp"
 #include "cmd_selftest.hpp"
 #include "commands.hpp"
@@ -317,6 +318,57 @@ int main(int argc, char** argv) {
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
   add_robot_options(calibrate, cal_o.robot);
   calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
+
+  // ---- render | montage | report (render layer)
+  cli::RenderOptions render_o;
+  auto* render = app.add_subcommand(
+      "render",
+      "Render one episode of a job headless (OSMesa) exactly as `run` runs it: same job id, contract, episode\n"
+      "seed, initial state and outcome as that episode's JSONL record, which is printed as one JSON line.\n"
+      "Writes an animated GIF (every step) or a PNG (one frame) with an overlay of the step, the phase\n"
+      "(reset / probe / act) and success. Episode E of contract I is the job's episode E * contracts + I.");
+  render->add_option("--task", render_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
+  render->add_option("--split", render_o.request.split, "Split manifest: a built-in name or a file")->required();
+  render->add_option("--method", render_o.request.method.name, "Method (as for run)")->required();
+  render->add_option("--params", render_o.method_params, "Method parameters as a JSON object")->capture_default_str();
+  render->add_option("--seed", render_o.request.seed, "Experimental seed of the job")->capture_default_str();
+  render->add_option("--episodes", render_o.request.episodes, "Episodes of the job (part of its id)")->capture_default_str();
+  render->add_option("--backbone", render_o.request.backbone, "Frozen policy")->capture_default_str();
+  render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");
+  render->add_option("--rotation-mode", render_o.request.rotation_mode, "live or identity")->capture_default_str();
+  render->add_option("--contract", render_o.contract, "Contract index in the split")->capture_default_str();
+  render->add_option("--episode", render_o.episode, "The contract's episode (0 = its first)")->capture_default_str();
+  render->add_option("--camera", render_o.camera,
+                     "default (the task's, like ManiSkill's human-render camera), front, side, top, or\n"
+                     "EX,EY,EZ,TX,TY,TZ[,FOV_DEG] (eye, target [m], vertical field of view)")
+      ->capture_default_str();
+  render->add_option("--size", render_o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  render->add_option("--frame", render_o.frame, "PNG only: the state after this many steps (-1: the last)")->capture_default_str();
+  render->add_option("--delay", render_o.delay_cs, "GIF: hundredths of a second per frame")->capture_default_str();
+  render->add_flag("--clean", render_o.clean, "Same episode seed with the identity contract (the clean reference panel)");
+  render->add_option("--label", render_o.label, "Overlay title (default: the method, or clean)");
+  render->add_flag("!--no-overlay", render_o.overlay, "No overlay");
+  render->add_option("--out", render_o.out, "Output FILE.gif or FILE.png")->required();
+  render->callback([&] { action = [&] { return cli::run_render(render_o); }; });
+
+  cli::MontageOptions montage_o;
+  auto* montage = app.add_subcommand(
+      "montage", "Place GIF renders side by side (shorter ones hold their last frame): an animated GIF, or one\n"
+                 "frame as PNG (e.g. the clean / no_adapt / adapted triptych).");
+  montage->add_option("inputs", montage_o.inputs, "Input GIF files, left to right")->required();
+  montage->add_option("--out", montage_o.out, "Output FILE.gif or FILE.png")->required();
+  montage->add_option("--frame", montage_o.frame, "PNG only: frame index (-1: the last)")->capture_default_str();
+  montage->add_option("--delay", montage_o.delay_cs, "GIF: hundredths of a second per frame")->capture_default_str();
+  montage->callback([&] { action = [&] { return cli::run_montage(montage_o); }; });
+
+  cli::ReportOptions report_o;
+  auto* report = app.add_subcommand(
+      "report", "Write a self-contained HTML page (index.html) and Markdown (report.md) for a results directory:\n"
+                "the results summary table, gate verdicts, SVG figures (Gate 1, adaptation ladders, probe-cost\n"
+                "Pareto, long lag; a figure whose inputs are absent is skipped) and the provenance of every number.");
+  report->add_option("results", report_o.results_dir, "Results directory")->required();
+  report->add_option("--out", report_o.out_dir, "Output directory")->required();
+  report->callback([&] { action = [&] { return cli::run_report(report_o); }; });
 
   try {
     app.parse(argc, argv);

@@ -92,6 +92,7 @@ struct Context {
   std::unique_ptr<policy::Policy> prototype;
   nlohmann::json params;
   sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
+  EpisodeHooks hooks;  // default: the runner's episodes, unobserved
 
   std::mutex mutex;
   std::map<unsigned, std::unique_ptr<Worker>> workers;
@@ -109,7 +110,7 @@ struct Context {
   EpisodeRecord run(const EpisodeTask& t) {
     Worker& w = worker(t.worker);
     const auto ci = static_cast<std::size_t>(t.contract_index);
-    const Contract& truth = contracts.at(ci);
+    const Contract& truth = hooks.contract_override ? *hooks.contract_override : contracts.at(ci);
     auto it = w.envs.find(t.contract_index);
     if (it == w.envs.end()) it = w.envs.emplace(t.contract_index, sim::HiddenContractEnv(model, truth, rotation)).first;
     sim::HiddenContractEnv& env = it->second;
@@ -128,12 +129,18 @@ struct Context {
     adapter->begin_episode(t.adapter_seed);  // never the environment's seed: it names the contract
     EpisodeRecord rec;
     rec.contract_sha256 = truth.sha256();
+    const sim::OracleRecorder view(env);
+    auto show = [&](int step, bool probe) {
+      if (hooks.observer) hooks.observer(EpisodeStepView{step, env.horizon(), probe, &env.last(), &view.env()});
+    };
+    show(0, false);
     for (int step = 0; step < env.horizon(); ++step) {
       const Action intent = w.policy->act(obs);
       const Mat3 R = rotation == sim::FrameRotation::kIdentity ? Mat3::Identity() : adapt::tcp_rotation(obs, slice);
       const Action raw = adapter->encode(intent, R);
       const bool probe = adapter->last_step().probe;
       const sim::StepResult& r = env.step(raw);
+      show(step + 1, probe);
       if (r.safety != sim::SafetyFlag::kNone) break;  // the episode ended by a safety check
       const Pose6 response_now = adapt::tcp_response(obs, r.obs, slice);
       if (probe) {
@@ -156,10 +163,13 @@ struct Context {
 
 }  // namespace
 
-EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) {
+EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) { return make_episode_fn(job, options, EpisodeHooks{}); }
+
+EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, EpisodeHooks hooks) {
   validate_job(job);
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
+  ctx->hooks = std::move(hooks);
   const sim::TaskId task = sim::parse_task(job.task);
   if (job.policy_files) {
     const std::string now = files_content_sha256(job.policy_files->paths, "policy_files");

@@ -88,6 +88,37 @@ class Progress {
 
 }  // namespace
 
+EpisodeTask episode_task(const JobSpec& job, std::int64_t episode_index, unsigned worker) {
+  if (episode_index < 0 || episode_index >= job.episodes)
+    throw std::invalid_argument("episode " + std::to_string(episode_index) + " is outside the job's " +
+                                std::to_string(job.episodes) + " episodes");
+  const auto slot = episode_slot(job.split.contracts, episode_index);
+  return EpisodeTask{&job,
+                     job.seed,
+                     slot.contract_index,
+                     slot.contract_episode,
+                     episode_index,
+                     episode_seed(job.seed, slot.contract_index, episode_index),
+                     adapter_episode_seed(job.seed, slot.contract_episode),
+                     worker};
+}
+
+void stamp_record(EpisodeRecord& r, const JobSpec& job, const std::string& job_id, const EpisodeTask& task) {
+  r.schema_version = std::string(kRecordSchemaVersion);
+  r.job_id = job_id;
+  r.task = job.task;
+  r.split = job.split.name;
+  r.method = job.method;
+  r.seed = job.seed;
+  r.contract_index = task.contract_index;
+  r.episode_index = task.episode_index;
+  r.backbone = job.backbone.name;
+  r.backbone_sha256 = job.backbone.sha256;
+  r.profile = job.profile;
+  r.actionshift_version = build_provenance().version;
+  r.git_commit = build_provenance().git_commit;
+}
+
 RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& options) {
   const auto t0 = Clock::now();
   std::ostream& log = options.log ? *options.log : std::cerr;
@@ -135,31 +166,11 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
         cv.wait(lock, [&] { return i < written + window || failure; });
         if (failure && i > failed_at) return;
       }
-      const auto slot = episode_slot(job.split.contracts, i);
-      EpisodeTask task{&job,
-                       job.seed,
-                       slot.contract_index,
-                       slot.contract_episode,
-                       i,
-                       episode_seed(job.seed, slot.contract_index, i),
-                       adapter_episode_seed(job.seed, slot.contract_episode),
-                       w};
+      const EpisodeTask task = episode_task(job, i, w);
       try {
         EpisodeRecord r = fn(task);
         // stamp the job fields; the episode function owns only the outcome and contract hash
-        r.schema_version = std::string(kRecordSchemaVersion);
-        r.job_id = store.job_id();
-        r.task = job.task;
-        r.split = job.split.name;
-        r.method = job.method;
-        r.seed = job.seed;
-        r.contract_index = slot.contract_index;
-        r.episode_index = i;
-        r.backbone = job.backbone.name;
-        r.backbone_sha256 = job.backbone.sha256;
-        r.profile = job.profile;
-        r.actionshift_version = build_provenance().version;
-        r.git_commit = build_provenance().git_commit;
+        stamp_record(r, job, store.job_id(), task);
         validate_record(r, "episode " + std::to_string(i));
         std::lock_guard lock(mu);
         ready.emplace(i, std::move(r));

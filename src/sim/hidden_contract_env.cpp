@@ -80,5 +80,6 @@ Action OracleRecorder::encode(const Action& canonical) const {
 }
 std::span<const Action> OracleRecorder::decoded() const { return env_->impl_->decoded; }
 std::span<const Action> OracleRecorder::applied() const { return env_->impl_->applied; }
+const Env& OracleRecorder::env() const { return env_->impl_->env; }
 
 }  // namespace actionshift::sim

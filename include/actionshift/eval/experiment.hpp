@@ -4,13 +4,20 @@
 /// backbone through the method's adapter in the hidden-contract environment.
 
 #include "actionshift/adapt/calibration.hpp"
+#include "actionshift/core/contract.hpp"
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/policy/external.hpp"
 
+#include <functional>
 #include <optional>
 #include <string>
+
+namespace actionshift::sim {
+class Env;
+struct StepResult;
+}  // namespace actionshift::sim
 
 namespace actionshift::eval {
 
@@ -42,5 +49,33 @@ struct EpisodeFnOptions {
 /// `live` mode, identity otherwise), the env steps the raw action, and the adapter observes the TCP
 /// response. Episodes run the full horizon (success does not end them) unless a safety check fires.
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options = {});
+
+/// What an episode observer is shown: the state after the reset (step 0) and after every control
+/// step of the episode, in order. The pointers are valid during the call only.
+struct EpisodeStepView {
+  int step{0};                              ///< control steps taken so far (0: the state after reset)
+  int horizon{0};                           ///< the task's horizon
+  bool probe{false};                        ///< the action just taken was an adapter probe
+  const sim::StepResult* result{nullptr};   ///< the environment's last result (success, safety)
+  const sim::Env* env{nullptr};             ///< the unwrapped environment, read-only (for rendering)
+};
+/// Called once per EpisodeStepView.
+using EpisodeObserver = std::function<void(const EpisodeStepView&)>;
+
+/// Extras of an observed episode function (`actionshift render`).
+struct EpisodeHooks {
+  EpisodeObserver observer;                 ///< called after the reset and after each step; may be null
+  /// Run this contract instead of the split's (the `--clean` render uses Contract::identity()); the
+  /// record's contract_sha256 is then this contract's. Not set: the split's contract, as the runner.
+  std::optional<Contract> contract_override;
+};
+
+/// The same episode function with hooks: with default hooks it is make_episode_fn(job, options), and
+/// with only an observer its episodes are those of the runner, step for step.
+EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, EpisodeHooks hooks);
+/// make_episode_fn(job, {}, hooks).
+inline EpisodeFn make_episode_fn(const JobSpec& job, EpisodeHooks hooks) {
+  return make_episode_fn(job, EpisodeFnOptions{}, std::move(hooks));
+}
 
 }  // namespace actionshift::eval

@@ -25,6 +25,16 @@ struct EpisodeTask {
   unsigned worker{0};                 ///< worker thread index in [0, threads): key per-worker state on it
 };
 
+/// The task of episode `episode_index` of `job` exactly as run_job hands it to a worker: its
+/// contract slot (episode_slot) and seed (episode_seed). Throws std::invalid_argument for an index
+/// outside [0, job.episodes).
+EpisodeTask episode_task(const JobSpec& job, std::int64_t episode_index, unsigned worker = 0);
+
+/// Stamp the job fields of an episode function's record exactly as run_job does before writing it:
+/// schema_version, job_id, task, split, method, seed, contract_index, episode_index, backbone,
+/// backbone_sha256.
+void stamp_record(EpisodeRecord& r, const JobSpec& job, const std::string& job_id, const EpisodeTask& task);
+
 /// Runs one episode. Called concurrently from several threads (each worker index from one thread at
 /// a time). It must be deterministic in the task, fill `contract_sha256` and the outcome fields
 /// (success_once, success_at_end, task_return, steps, probe_steps, probe_displacement,

@@ -88,6 +88,8 @@ class OracleRecorder {
   std::span<const Action> decoded() const;
   /// Action handed to the controller at each step of this episode (after the lag FIFO).
   std::span<const Action> applied() const;
+  /// The wrapped environment, read-only (what a renderer draws: sim::scene_of(recorder.env())).
+  const Env& env() const;
 
  private:
   const HiddenContractEnv* env_;

@@ -1,0 +1,49 @@
+#pragma once
+// `actionshift render` (an episode as GIF or PNG), `actionshift montage` (renders side by side) and
+// `actionshift report` (HTML + Markdown page with figures): plain functions, no CLI11 here.
+
+#include "actionshift/eval/plan.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace actionshift::cli {
+
+// `actionshift render --task T --split S --method M [--contract I] [--episode E] [--camera C]
+//  [--size WxH] [--frame K] [--clean] [--label L] [--no-overlay] --out FILE.gif|png`
+// plus the job options of `run` (--seed, --episodes, --backbone, --pool, --params, --rotation-mode).
+struct RenderOptions {
+  eval::JobRequest request;         // the job, resolved exactly as `run` resolves it
+  std::string method_params{"{}"};  // --params
+  std::int64_t contract{0};         // --contract I: contract index in the split
+  std::int64_t episode{0};          // --episode E: the contract's E-th episode (job episode E * contracts + I)
+  std::string camera{"default"};    // --camera
+  std::string size{"320x240"};      // --size WxH
+  int frame{-1};                    // --frame K (PNG only): the state after K steps; -1: the last
+  bool clean{false};                // --clean: identity contract, same episode seed
+  std::string label;                // --label: overlay title (default: the method, or "clean")
+  bool overlay{true};               // --no-overlay
+  int delay_cs{10};                 // --delay: GIF frame time in 1/100 s
+  std::string out;                  // --out FILE.gif|FILE.png
+};
+int run_render(const RenderOptions& o);
+
+// `actionshift montage IN.gif... --out OUT.gif|png [--frame K]`: GIF renders side by side; shorter
+// inputs hold their last frame. PNG output: frame K (default: the last).
+struct MontageOptions {
+  std::vector<std::string> inputs;
+  std::string out;
+  int frame{-1};
+  int delay_cs{10};
+};
+int run_montage(const MontageOptions& o);
+
+// `actionshift report RESULTS_DIR --out DIR`
+struct ReportOptions {
+  std::string results_dir;
+  std::string out_dir;
+};
+int run_report(const ReportOptions& o);
+
+}  // namespace actionshift::cli

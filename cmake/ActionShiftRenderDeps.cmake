@@ -1,0 +1,11 @@
+# Dependencies of the static ActionShift::render archive (linked PRIVATE, still needed at link time).
+include(CMakeFindDependencyMacro)
+find_dependency(PkgConfig)
+if(NOT TARGET PkgConfig::OSMESA)
+  pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
+endif()
+if(NOT TARGET PkgConfig::BULLET)
+  pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
+endif()
+find_dependency(PNG)
+find_dependency(GIF)

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# End-to-end: actionshift render / montage / report. Usage: cli_render_test.sh <actionshift> <source dir>
+set -euo pipefail
+AS="$1"
+source "$(dirname "$0")/lib.sh"
+
+JOB=(--task pick_cube --split reference_seen --episodes 2)
+
+# bad output paths and cameras: one line, exit 2, before any episode runs
+run "$AS" render "${JOB[@]}" --method no_adapt --out "$TMP/x.txt"
+expect_rc 2 "render to .txt"; expect_one_line_error "render to .txt"; expect_err "must end in .gif or .png" "render to .txt"
+touch "$TMP/plainfile"
+run "$AS" render "${JOB[@]}" --method no_adapt --out "$TMP/plainfile/x.gif"
+expect_rc 2 "render under a file"; expect_one_line_error "render under a file"; expect_err "$TMP/plainfile/x.gif: --out:" "render under a file"
+run "$AS" render "${JOB[@]}" --method no_adapt --out "$TMP"
+expect_rc 2 "render to a directory"; expect_one_line_error "render to a directory"
+run "$AS" render "${JOB[@]}" --method no_adapt --camera fisheye --out "$TMP/x.gif"
+expect_rc 2 "unknown camera"; expect_one_line_error "unknown camera"; expect_err "--camera: 'fisheye'" "unknown camera"
+[ ! -e "$TMP/x.gif" ] && ok || bad "a failed render left a file"
+run "$AS" render "${JOB[@]}" --method no_adapt --contract 2 --out "$TMP/x.gif"
+expect_rc 2 "contract outside the split"; expect_one_line_error "contract outside the split"
+run "$AS" render "${JOB[@]}" --method no_adapt --size 10x10 --out "$TMP/x.gif"
+expect_rc 2 "bad size"; expect_one_line_error "bad size"
+
+# the render's outcome is the runner's record of the same episode
+run "$AS" run "${JOB[@]}" --method oracle --threads 2 --progress off --out "$TMP/runs"
+expect_rc 0 "run oracle"
+run "$AS" render "${JOB[@]}" --method oracle --contract 1 --episode 0 --size 96x72 --out "$TMP/ep.gif"
+expect_rc 0 "render gif"
+printf '%s\n' "$OUT" > "$TMP/render.json"
+python3 - "$TMP/render.json" "$TMP/runs" <<'PY' && ok || bad "render record differs from the runner's"
+import glob, json, sys
+r = json.loads(open(sys.argv[1]).read())
+r.pop("rendered"); r.pop("clean")
+recs = [json.loads(l) for f in glob.glob(sys.argv[2] + "/*.jsonl") for l in open(f)]
+match = [x for x in recs if x["episode_index"] == 1]
+assert len(match) == 1 and match[0] == r, (match, r)
+PY
+[ "$(head -c 6 "$TMP/ep.gif")" = "GIF89a" ] && ok || bad "not a GIF"
+[ "$(stat -c %s "$TMP/ep.gif")" -gt 1000 ] && ok || bad "GIF too small"
+run "$AS" render "${JOB[@]}" --method oracle --frame 0 --camera top --no-overlay --size 64x48 --out "$TMP/ep.png"
+expect_rc 0 "render png"
+[ "$(head -c 4 "$TMP/ep.png" | tail -c 3)" = "PNG" ] && ok || bad "not a PNG"
+
+# montage
+run "$AS" montage "$TMP/ep.gif" "$TMP/ep.gif" --out "$TMP/two.gif"
+expect_rc 0 "montage"; expect_out "2 panels" "montage"
+run "$AS" montage "$TMP/missing.gif" --out "$TMP/two.gif"
+expect_rc 2 "montage of a missing file"; expect_one_line_error "montage of a missing file"
+
+# report after a premise-like run (tiny episode counts)
+P=(--task pick_cube --split seen --episodes 4 --threads 2 --progress off --out "$TMP/premise")
+run "$AS" run "${P[@]}" --method oracle; expect_rc 0 "premise oracle"
+run "$AS" run "${P[@]}" --method no_adapt; expect_rc 0 "premise no_adapt"
+run "$AS" gate1 --results "$TMP/premise"
+run "$AS" report "$TMP/premise" --out "$TMP/report"
+expect_rc 0 "report"; expect_out "figures" "report"
+[ -s "$TMP/report/index.html" ] && [ -s "$TMP/report/report.md" ] && ok || bad "report pages missing"
+[ -s "$TMP/report/figures/gate1.svg" ] && ok || bad "no Gate 1 figure"
+grep -q 'src="figures/gate1.svg"' "$TMP/report/index.html" && ok || bad "page lacks the Gate 1 figure"
+missing=0; n=0
+while read -r t; do
+  n=$((n + 1))
+  case "$t" in
+    \#*) grep -q "id=\"${t#\#}\"" "$TMP/report/index.html" || { missing=1; echo "broken anchor $t" >&2; } ;;
+    *) [ -e "$TMP/report/$t" ] || { missing=1; echo "broken link $t" >&2; } ;;
+  esac
+done < <(grep -o -E '(src|href)="[^"]+"' "$TMP/report/index.html" | sed -E 's/^(src|href)="//; s/"$//')
+[ "$missing" = 0 ] && [ "$n" -ge 4 ] && ok || bad "report links ($n checked)"
+run "$AS" report "$TMP/nowhere" --out "$TMP/report2"
+expect_rc 2 "report of a missing directory"; expect_one_line_error "report of a missing directory"
+
+# the page in a real headless browser, when Debian's chromium is installed
+if [ -x /usr/bin/chromium ]; then
+  run timeout 120 /usr/bin/chromium --headless --no-sandbox --disable-gpu --screenshot="$TMP/shot.png" \
+    --window-size=1200,2000 "file://$TMP/report/index.html"
+  [ -s "$TMP/shot.png" ] && ok || bad "chromium did not render the page: $ERR"
+else
+  echo "note: /usr/bin/chromium absent: the headless-browser check is skipped (apt-get install chromium to run it)"
+fi
+finish
