@@ -7,7 +7,9 @@
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
+#include "actionshift/policy/policy.hpp"
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -36,5 +38,11 @@ std::string resolved_method_params(const std::string& method, const std::string&
 /// `live` mode, identity otherwise), the env steps the raw action, and the adapter observes the TCP
 /// response. Episodes run the full horizon (success does not end them) unless a safety check fires.
 EpisodeFn make_episode_fn(const JobSpec& job);
+
+/// The same episode function with the backbone supplied by the caller instead of resolved by name
+/// (e.g. a policy implemented in the host process, such as a Python callable). Its name() and
+/// sha256() must equal the spec's backbone (InputError otherwise); each runner worker uses its own
+/// `backbone->clone()`.
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone);
 
 }  // namespace actionshift::eval
