@@ -89,7 +89,7 @@ struct Context {
   std::vector<Contract> pool;
   std::optional<adapt::ResponseModel> response;
   adapt::TcpSlice slice;
-  std::unique_ptr<policy::Policy> prototype;
+  std::shared_ptr<const policy::Policy> prototype;
   nlohmann::json params;
   sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
   EpisodeHooks hooks;  // default: the runner's episodes, unobserved
@@ -167,6 +167,15 @@ EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) {
 
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, EpisodeHooks hooks) {
   validate_job(job);
+  policy::RegistryOptions registry;
+  registry.external = options.external;
+  return make_episode_fn(job, std::shared_ptr<const policy::Policy>(policy::make_policy(job.backbone.name, sim::parse_task(job.task), registry)),
+                         std::move(hooks));
+}
+
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks) {
+  validate_job(job);
+  if (!backbone) throw InputError("job", "backbone", "no backbone given");
   auto ctx = std::make_shared<Context>();
   ctx->job = job;
   ctx->hooks = std::move(hooks);
@@ -215,9 +224,11 @@ EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, E
       throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
     ctx->response = cal.model();
   }
-  policy::RegistryOptions registry;
-  registry.external = options.external;
-  ctx->prototype = policy::make_policy(job.backbone.name, task, registry);
+  if (backbone->name() != job.backbone.name)
+    throw InputError("backbone " + backbone->name(), "name", "is not the job's backbone " + job.backbone.name);
+  if (backbone->task() != task)
+    throw InputError("backbone " + backbone->name(), "task", "acts on " + std::string(sim::task_name(backbone->task())) + ", not " + job.task);
+  ctx->prototype = std::move(backbone);
   if (ctx->prototype->sha256() != job.backbone.sha256)
     throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
   ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));

@@ -9,8 +9,10 @@
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/policy/external.hpp"
+#include "actionshift/policy/policy.hpp"
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -77,5 +79,11 @@ EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, E
 inline EpisodeFn make_episode_fn(const JobSpec& job, EpisodeHooks hooks) {
   return make_episode_fn(job, EpisodeFnOptions{}, std::move(hooks));
 }
+
+/// The same episode function with the backbone supplied by the caller instead of resolved by name
+/// (e.g. a policy implemented in the host process, such as a Python callable). Its name() and
+/// sha256() must equal the spec's backbone (InputError otherwise); each runner worker uses its own
+/// `backbone->clone()`.
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks = {});
 
 }  // namespace actionshift::eval

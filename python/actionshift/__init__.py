@@ -1,0 +1,277 @@
+"""ActionShift from Python: hidden action-interface adaptation for robot manipulation.
+
+The heavy lifting is native (C++, the same library as the ``actionshift`` CLI); this package adds
+the Gymnasium-style environment classes. See docs/python.md.
+
+    >>> import actionshift
+    >>> env = actionshift.make("pick_cube", split="seen", index=3)   # a hidden contract
+    >>> obs, info = env.reset(seed=1)
+    >>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+"""
+import json as _json
+import sys as _sys
+
+import numpy as _np
+
+from . import _native
+from ._native import (  # noqa: F401  (re-exported API)
+    Adapter,
+    Contract,
+    Decoder,
+    InputError,
+    Manifest,
+    SelfTest,
+    builtin_manifests,
+    decode,
+    decode_jacobian,
+    encode,
+    load_manifest,
+    method_needs_calibration,
+    method_needs_pool,
+    method_params,
+    methods,
+    pool_sha256,
+    selftest_library,
+    tasks,
+    tcp_response,
+    tcp_rotation,
+)
+
+__all__ = [
+    "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
+    "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
+    "make_adapter", "make_vec", "method_needs_calibration", "method_needs_pool", "method_params",
+    "methods", "pool_sha256", "selftest_library", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
+]
+
+PROFILES = ("maniskill",)
+"""Fidelity profiles this build's simulator accepts (``profile=`` of make/make_vec/evaluate)."""
+
+try:  # Gymnasium is optional: with it, environments subclass gymnasium.Env and are registered
+    import gymnasium as _gym
+    from gymnasium import spaces as _gym_spaces
+except ImportError:  # pragma: no cover - depends on the machine
+    _gym = None
+    _gym_spaces = None
+
+
+class Box:
+    """A box space (used when gymnasium is not installed): shape, low, high, dtype."""
+
+    def __init__(self, low, high, shape, dtype=_np.float64, seed=None):
+        self.shape = tuple(shape)
+        self.dtype = _np.dtype(dtype)
+        self.low = _np.broadcast_to(_np.asarray(low, dtype=self.dtype), self.shape).copy()
+        self.high = _np.broadcast_to(_np.asarray(high, dtype=self.dtype), self.shape).copy()
+        self._rng = _np.random.default_rng(seed)
+
+    def seed(self, seed=None):
+        self._rng = _np.random.default_rng(seed)
+        return [seed]
+
+    def sample(self):
+        """Uniform in [low, high] where both are finite, standard normal elsewhere."""
+        finite = _np.isfinite(self.low) & _np.isfinite(self.high)
+        out = self._rng.standard_normal(self.shape)
+        out[finite] = self._rng.uniform(self.low[finite], self.high[finite])
+        return out.astype(self.dtype)
+
+    def contains(self, x):
+        x = _np.asarray(x)
+        return x.shape == self.shape and bool(_np.all(x >= self.low) and _np.all(x <= self.high))
+
+    __contains__ = contains
+
+    def __repr__(self):
+        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
+
+
+def _box(low, high, shape):
+    if _gym_spaces is not None:
+        return _gym_spaces.Box(low=low, high=high, shape=shape, dtype=_np.float64)
+    return Box(low, high, shape)
+
+
+_EnvBase = _gym.Env if _gym is not None else object
+_TASK_IDS = {
+    "pick_cube": "PickCube-v1",
+    "push_cube": "PushCube-v1",
+    "pull_cube": "PullCube-v1",
+    "stack_cube": "StackCube-v1",
+    "peg_insertion_side": "PegInsertionSide-v1",
+}
+
+
+def _check_profile(profile):
+    _native.env_config_check(profile)
+
+
+class Env(_EnvBase):
+    """One Bullet Panda task under a hidden action contract, with Gymnasium's API.
+
+    ``reset(seed=None, options=None) -> (obs, info)``; ``step(action) -> (obs, reward, terminated,
+    truncated, info)``. ``terminated`` is task success (ManiSkill's convention) or an episode ended by
+    a safety check; ``truncated`` is the horizon. ``info`` holds ``success``, ``success_once``,
+    ``safety`` (``"none"`` or the flag that ended the episode), ``elapsed_steps``,
+    ``episode_return`` and ``clipped_steps``. The contract is never observable through the env.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, task="pick_cube", contract=None, split=None, index=0, rotation="live", profile="maniskill"):
+        self._env = _native._Env(task, contract, split, int(index), rotation, profile)
+        n = self._env.obs_dim
+        self.observation_space = _box(-_np.inf, _np.inf, (n,))
+        self.action_space = _box(-1.0, 1.0, (7,))
+        self.horizon = self._env.horizon
+        self.layout = self._env.layout
+        self.profile = profile
+        self.rotation = rotation
+        self.render_mode = None
+
+    def reset(self, *, seed=None, options=None):
+        """Start an episode; the initial state is a pure function of ``seed`` (None: the next
+        seed of this env's sequence, so ``reset(seed=s)`` then ``reset()`` is reproducible)."""
+        if seed is not None and (not isinstance(seed, (int, _np.integer)) or seed < 0):
+            raise ValueError(f"seed: must be a nonnegative integer (got {seed!r})")
+        return self._env.reset(None if seed is None else int(seed))
+
+    def step(self, action):
+        return self._env.step(action)
+
+    @property
+    def task(self):
+        return self._env.task
+
+    def field(self, obs, name):
+        """The slice of an observation named ``name`` (e.g. ``"tcp_pose"``, ``"goal_pos"``)."""
+        for f in self.layout:
+            if f["name"] == name:
+                return obs[f["offset"]:f["offset"] + f["width"]]
+        raise KeyError(f"observation has no field {name!r} (fields: {[f['name'] for f in self.layout]})")
+
+    def close(self):
+        pass
+
+    def __repr__(self):
+        return f"<actionshift.Env {self.task} rotation={self.rotation} profile={self.profile}>"
+
+
+class VecEnv:
+    """``num_envs`` environments stepped together in C++ on worker threads (see make_vec)."""
+
+    def __init__(self, task="pick_cube", num_envs=1, contract=None, split=None, index=0, rotation="live",
+                 profile="maniskill", threads=0):
+        self._env = _native._VecEnv(task, int(num_envs), contract, split, int(index), rotation, profile, int(threads))
+        self.num_envs = self._env.num_envs
+        n = self._env.obs_dim
+        self.single_observation_space = _box(-_np.inf, _np.inf, (n,))
+        self.single_action_space = _box(-1.0, 1.0, (7,))
+        self.observation_space = _box(-_np.inf, _np.inf, (self.num_envs, n))
+        self.action_space = _box(-1.0, 1.0, (self.num_envs, 7))
+        self.horizon = self._env.horizon
+        self.threads = self._env.threads
+
+    def reset(self, *, seed=None, options=None):
+        """Reset every environment; environment i gets seed ``seed + i``."""
+        if seed is not None and (not isinstance(seed, (int, _np.integer)) or seed < 0):
+            raise ValueError(f"seed: must be a nonnegative integer (got {seed!r})")
+        return self._env.reset(None if seed is None else int(seed))
+
+    def step(self, actions):
+        """``actions`` (num_envs, 7) -> (obs, reward, terminated, truncated, info), arrays over envs.
+        Ended environments are reset at once (next seed of their sequence); their last observation
+        is ``info["final_obs"][i]`` and ``info["autoreset"][i]`` is True."""
+        return self._env.step(actions)
+
+    def close(self):
+        pass
+
+
+def make(task="pick_cube", contract=None, split=None, index=0, profile="maniskill", rotation="live"):
+    """An environment for ``task`` under a hidden contract.
+
+    contract: an ``actionshift.Contract``, its JSON text or dict; or ``split`` (a built-in split name
+    such as ``"seen"``, or a manifest path) and ``index`` (its ``index``-th evaluation contract);
+    neither: the identity contract (raw actions are canonical). rotation: ``"live"`` (tool frame =
+    TCP orientation) or ``"identity"``. profile: the simulator's fidelity profile (``PROFILES``).
+    """
+    return Env(task, contract=contract, split=split, index=index, rotation=rotation, profile=profile)
+
+
+def make_vec(task="pick_cube", num_envs=2, contract=None, split=None, index=0, profile="maniskill",
+             rotation="live", threads=0):
+    """``num_envs`` environments stepped in C++ on ``threads`` worker threads (0: all cores).
+    With a split, environment i runs evaluation contract ``(index + i) mod n``."""
+    return VecEnv(task, num_envs=num_envs, contract=contract, split=split, index=index, rotation=rotation,
+                  profile=profile, threads=threads)
+
+
+def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None):
+    """An adapter by method name (``methods()``): ``begin_episode(seed)``, ``encode(canonical, R)``
+    -> raw action, ``observe(raw, response, R)``. Belief methods use the task's built-in response
+    calibration; pool methods need ``pool`` (a pool name such as ``"reference9"``, a manifest path,
+    or a list of contracts); the oracle needs ``truth``. ``params``: method parameters (dict)."""
+    return _native._make_adapter(method, task, pool, truth, params)
+
+
+def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,
+             out="results", backbone=None, pool=None, params=None, rotation="live", profile="maniskill",
+             progress="off"):
+    """Run ``policy`` (a callable obs -> 7 canonical numbers; its ``reset()`` is called at each
+    episode start if it has one) as the backbone of one hash-addressed job, in this process,
+    through the library's runner: ``<out>/<job id>.jsonl`` and ``.summary.json``, exactly as
+    ``actionshift run`` writes them. Returns a dict with ``job_id``, ``jsonl_path``,
+    ``summary_path``, ``episodes_run``, ``wall_time_s`` and the ``job`` spec.
+
+    backbone: the backbone's name in the job. ``"external:<command>"`` gives the job (id and JSONL)
+    that ``actionshift run --backbone "external:<command>"`` writes when that command serves the same
+    policy (e.g. through ``serve_policy``); default ``"python:<module>.<name>"`` of the callable.
+    """
+    if backbone is None:
+        target = policy if hasattr(policy, "__qualname__") else type(policy)
+        backbone = f"python:{getattr(target, '__module__', '?')}.{target.__qualname__}"
+    return _native._evaluate(policy, task, split, method, int(seed), int(episodes), str(out), backbone, pool,
+                             params, rotation, profile, progress)
+
+
+def serve_policy(policy, stdin=None, stdout=None):
+    """Serve ``policy`` (a callable, or a factory ``task -> callable`` if it has attribute
+    ``from_task``) over the external-policy protocol (actionshift-policy-v1, docs/backbones.md) on
+    stdin/stdout, so ``actionshift run --backbone "external:python3 my_policy.py"`` runs it."""
+    fin = stdin or _sys.stdin
+    fout = stdout or _sys.stdout
+    current = policy
+    for line in fin:
+        line = line.strip()
+        if not line:
+            continue
+        msg = _json.loads(line)
+        kind = msg.get("type")
+        if kind == "hello":
+            if hasattr(policy, "from_task"):
+                current = policy.from_task(msg["task"])
+            fout.write('{"type":"ready"}\n')
+            fout.flush()
+        elif kind == "reset":
+            if hasattr(current, "reset"):
+                current.reset()
+        elif kind == "step":
+            action = _np.asarray(current(_np.asarray(msg["obs"], dtype=_np.float64)), dtype=_np.float64)
+            fout.write(_json.dumps({"action": [float(x) for x in action.reshape(-1)]}) + "\n")
+            fout.flush()
+
+
+def _register_gymnasium():
+    if _gym is None:
+        return
+    from gymnasium.envs.registration import register, registry
+
+    for task, name in _TASK_IDS.items():
+        env_id = f"ActionShift/{name}"
+        if env_id not in registry:
+            register(id=env_id, entry_point="actionshift:Env", kwargs={"task": task},
+                     max_episode_steps=None, disable_env_checker=True)
+
+
+_register_gymnasium()

@@ -1,0 +1,975 @@
+// The native part of the `actionshift` Python package (python/actionshift/__init__.py wraps it).
+// This is the only translation unit that includes pybind11: contracts and the core, manifests and
+// pools, the hidden-contract environment (single and vectorised), adapters, the self-test, and
+// evaluate() running a Python callable as the backbone through the library's own job runner.
+#include "actionshift/adapt/registry.hpp"
+#include "actionshift/adapt/response.hpp"
+#include "actionshift/core/contract.hpp"
+#include "actionshift/core/decoder.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/core/manifest.hpp"
+#include "actionshift/core/transforms.hpp"
+#include "actionshift/core/validate.hpp"
+#include "actionshift/data/builtin_manifests.hpp"
+#include "actionshift/eval/calibrate.hpp"
+#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/job.hpp"
+#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/runner.hpp"
+#include "actionshift/policy/policy.hpp"
+#include "actionshift/selftest/library.hpp"
+#include "actionshift/selftest/selftest.hpp"
+#include "actionshift/selftest/verdict.hpp"
+#include "actionshift/sim/env.hpp"
+#include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/task.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace py = pybind11;
+using namespace actionshift;
+
+namespace {
+
+using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// ---------------------------------------------------------------- conversions
+
+[[noreturn]] void value_error(const std::string& msg) { throw py::value_error(msg); }
+
+std::string shape_of(const DArray& a) {
+  std::ostringstream s;
+  s << "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s << (i ? ", " : "") << a.shape(i);
+  s << (a.ndim() == 1 ? ",)" : ")");
+  return s.str();
+}
+
+DArray as_array(py::handle h, const char* what) {
+  try {
+    return DArray::ensure(h);
+  } catch (const py::error_already_set&) {
+  }
+  value_error(std::string(what) + ": not convertible to an array of numbers");
+}
+
+// a 1-D array of exactly n numbers (a list, tuple or numpy array of any numeric dtype)
+template <int N>
+Eigen::Matrix<double, N, 1> to_vec(py::handle h, const char* what) {
+  DArray a = DArray::ensure(h);
+  if (!a) {
+    PyErr_Clear();
+    value_error(std::string(what) + ": must be " + std::to_string(N) + " numbers");
+  }
+  if (a.ndim() != 1 || a.shape(0) != N)
+    value_error(std::string(what) + ": must be " + std::to_string(N) + " numbers (got shape " + shape_of(a) + ")");
+  Eigen::Matrix<double, N, 1> v;
+  std::copy(a.data(), a.data() + N, v.data());
+  return v;
+}
+
+Mat3 to_rotation(py::handle h, const char* what) {
+  if (h.is_none()) return Mat3::Identity();
+  DArray a = DArray::ensure(h);
+  if (!a) {
+    PyErr_Clear();
+    value_error(std::string(what) + ": must be a 3x3 rotation matrix");
+  }
+  if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
+    value_error(std::string(what) + ": must be a 3x3 rotation matrix (got shape " + shape_of(a) + ")");
+  Mat3 R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = a.at(i, j);
+  std::string why;
+  if (!is_rotation(R, &why)) value_error(std::string(what) + ": " + why);
+  return R;
+}
+
+Pose6 to_target(py::handle h) { return h.is_none() ? Pose6::Zero() : to_vec<kPoseDim>(h, "tracked_target"); }
+
+DArray vec_out(const double* p, py::ssize_t n) {
+  DArray out(n);
+  std::copy(p, p + n, out.mutable_data());
+  return out;
+}
+template <typename V>
+DArray vec_out(const V& v) {
+  return vec_out(v.data(), static_cast<py::ssize_t>(v.size()));
+}
+
+DArray mat_out(const Mat3& R) {
+  DArray out({3, 3});
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out.mutable_at(i, j) = R(i, j);
+  return out;
+}
+
+py::object json_to_py(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+std::string py_to_json(py::handle h) { return py::module_::import("json").attr("dumps")(h).cast<std::string>(); }
+
+Contract contract_from_text(const std::string& text) {
+  try {
+    return Contract::from_json(text);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("contract", "", e.what());
+  }
+}
+
+// a Contract, its JSON text or a dict of its fields
+Contract to_contract(py::handle h) {
+  if (py::isinstance<Contract>(h)) return h.cast<Contract>();
+  if (py::isinstance<py::str>(h)) return contract_from_text(h.cast<std::string>());
+  if (py::isinstance<py::dict>(h)) return contract_from_text(py_to_json(h));
+  throw py::type_error("contract: expected an actionshift.Contract, its JSON text or a dict");
+}
+
+std::vector<Contract> to_contracts(py::handle h, const char* what) {
+  if (py::isinstance<py::str>(h)) return data::resolve_manifest(h.cast<std::string>()).contracts();
+  std::vector<Contract> out;
+  for (py::handle x : h) out.push_back(to_contract(x));
+  if (out.empty()) value_error(std::string(what) + ": must not be empty");
+  return out;
+}
+
+// ---------------------------------------------------------------- fidelity profile
+
+// The one place a profile name becomes simulator settings. This build's simulator has a single
+// fidelity profile, "maniskill" (the default EnvConfig); every other name is rejected.
+sim::EnvConfig env_config_for_profile(const std::string& profile) {
+  if (profile == "maniskill") return sim::EnvConfig{};
+  throw InputError("profile", "", "unknown profile '" + profile + "' (this build has: maniskill)");
+}
+
+// Env models are immutable and shareable; building one loads the robot, so they are cached.
+std::shared_ptr<const sim::EnvModel> env_model(sim::TaskId task, const std::string& profile) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, std::string>, std::shared_ptr<const sim::EnvModel>> cache;
+  const sim::EnvConfig config = env_config_for_profile(profile);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& m = cache[{static_cast<int>(task), profile}];
+  if (!m) m = sim::EnvModel::make(task, config);
+  return m;
+}
+
+sim::FrameRotation parse_rotation(const std::string& r) {
+  if (r == "live") return sim::FrameRotation::kLiveTcp;
+  if (r == "identity") return sim::FrameRotation::kIdentity;
+  throw InputError("rotation", "", "expected 'live' or 'identity' (got '" + r + "')");
+}
+
+Manifest split_manifest(const std::string& name) {
+  Manifest m = data::resolve_manifest(name);
+  if (m.is_pool()) throw InputError(name, "kind", "is a pool, not a split manifest");
+  return m;
+}
+
+// the contract of make()/make_vec(): explicit, or test[index] of a split, or identity
+Contract pick_contract(py::handle contract, const std::optional<std::string>& split, std::int64_t index) {
+  if (!contract.is_none()) {
+    if (split) throw InputError("make", "contract", "give either a contract or a split, not both");
+    return to_contract(contract);
+  }
+  if (!split) return Contract::identity();
+  const Manifest m = split_manifest(*split);
+  const auto n = static_cast<std::int64_t>(m.test().size());
+  if (index < 0 || index >= n)
+    throw InputError(*split, "index", "out of range (the split has " + std::to_string(n) + " contracts, got " + std::to_string(index) + ")");
+  return m.test()[static_cast<std::size_t>(index)].contract;
+}
+
+// ---------------------------------------------------------------- environments
+
+py::dict step_info(const sim::StepResult& r, const sim::EpisodeStats& st) {
+  py::dict info;
+  info["success"] = r.success;
+  info["success_once"] = st.success_once;
+  info["safety"] = std::string(sim::safety_flag_name(r.safety));
+  info["elapsed_steps"] = r.elapsed_steps;
+  info["episode_return"] = st.episode_return;
+  info["clipped_steps"] = st.clipped_steps;
+  return info;
+}
+
+std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
+  last = last ? eval::splitmix64(*last) : 0;
+  return *last;
+}
+
+// One environment under a hidden contract (identity if none was given). Observations come back as
+// fresh numpy arrays (one copy of ~40 doubles, so a stored observation is never overwritten);
+// actions are read in place when they are float64 and contiguous.
+class PyEnv {
+ public:
+  PyEnv(const std::string& task, py::handle contract, std::optional<std::string> split, std::int64_t index,
+        const std::string& rotation, const std::string& profile)
+      : model_(env_model(sim::parse_task(task), profile)),
+        env_(model_, pick_contract(contract, split, index), parse_rotation(rotation)),
+        profile_(profile),
+        rotation_(rotation) {}
+
+  py::tuple reset(std::optional<std::uint64_t> seed) {
+    const std::uint64_t s = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
+    const Eigen::VectorXd* obs = nullptr;
+    {
+      py::gil_scoped_release release;
+      obs = &env_.reset(s);
+    }
+    py::dict info = step_info(env_.last(), env_.episode());
+    info["seed"] = s;
+    return py::make_tuple(vec_out(*obs), info);
+  }
+
+  py::tuple step(py::handle action) {
+    DArray a = DArray::ensure(action);
+    if (!a) {
+      PyErr_Clear();
+      value_error("action: not convertible to an array of numbers");
+    }
+    if (a.ndim() != 1) value_error("action: must be a 1-D array of 7 numbers (got shape " + shape_of(a) + ")");
+    const std::span<const double> raw(a.data(), static_cast<std::size_t>(a.shape(0)));
+    const sim::StepResult* r = nullptr;
+    {
+      py::gil_scoped_release release;
+      r = &env_.step(raw);
+    }
+    const bool safety = r->safety != sim::SafetyFlag::kNone;
+    return py::make_tuple(vec_out(r->obs), r->reward, r->terminated || safety, r->truncated && !safety,
+                          step_info(*r, env_.episode()));
+  }
+
+  const std::string& task() const { return task_name_ = std::string(sim::task_name(env_.task())); }
+  int horizon() const { return env_.horizon(); }
+  int obs_dim() const { return env_.layout().size(); }
+  py::list layout() const {
+    py::list out;
+    for (const auto& f : env_.layout().fields()) {
+      py::dict d;
+      d["name"] = f.name;
+      d["offset"] = f.offset;
+      d["width"] = f.width;
+      out.append(d);
+    }
+    return out;
+  }
+  const std::string& profile() const { return profile_; }
+  const std::string& rotation() const { return rotation_; }
+
+ private:
+  std::shared_ptr<const sim::EnvModel> model_;
+  sim::HiddenContractEnv env_;
+  std::string profile_, rotation_;
+  std::optional<std::uint64_t> last_seed_;
+  mutable std::string task_name_;
+};
+
+// A fixed set of worker threads that run a function over [0, n) in chunks; the caller waits.
+class WorkerPool {
+ public:
+  explicit WorkerPool(unsigned threads) {
+    for (unsigned t = 1; t < threads; ++t) threads_.emplace_back([this, t] { loop(t); });
+    size_ = threads;
+  }
+  ~WorkerPool() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    for (auto& t : threads_) t.join();
+  }
+  unsigned size() const { return size_; }
+  // fn(t) for t in [0, size): slot 0 on the calling thread
+  void run(const std::function<void(unsigned)>& fn) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      fn_ = &fn;
+      pending_ = size_ - 1;
+      ++generation_;
+    }
+    cv_.notify_all();
+    std::exception_ptr first;
+    try {
+      fn(0);
+    } catch (...) {
+      first = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(m_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    if (!first) first = error_;
+    error_ = nullptr;
+    if (first) std::rethrow_exception(first);
+  }
+
+ private:
+  void loop(unsigned t) {
+    std::uint64_t seen = 0;
+    for (;;) {
+      const std::function<void(unsigned)>* fn = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(m_);
+        cv_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        fn = fn_;
+      }
+      std::exception_ptr err;
+      try {
+        (*fn)(t);
+      } catch (...) {
+        err = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(m_);
+      if (err && !error_) error_ = err;
+      if (--pending_ == 0) done_.notify_all();
+    }
+  }
+  std::vector<std::thread> threads_;
+  unsigned size_{1};
+  std::mutex m_;
+  std::condition_variable cv_, done_;
+  const std::function<void(unsigned)>* fn_{nullptr};
+  unsigned pending_{0};
+  std::uint64_t generation_{0};
+  bool stop_{false};
+  std::exception_ptr error_;
+};
+
+// num_envs environments stepped together on worker threads (the GIL is released while they step).
+// Environment i runs the given contract, or test[(index + i) mod n] of a split; reset(seed) seeds
+// environment i with seed + i. An environment whose episode ends (terminated or truncated) is
+// reset in the same call: the returned row is the new episode's first observation and
+// info["final_obs"][i] the last one of the ended episode.
+class PyVecEnv {
+ public:
+  PyVecEnv(const std::string& task, int num_envs, py::handle contract, std::optional<std::string> split,
+           std::int64_t index, const std::string& rotation, const std::string& profile, unsigned threads)
+      : model_(env_model(sim::parse_task(task), profile)) {
+    if (num_envs < 1) throw InputError("make_vec", "num_envs", "must be at least 1 (got " + std::to_string(num_envs) + ")");
+    const sim::FrameRotation rot = parse_rotation(rotation);
+    std::vector<Contract> contracts;
+    if (split && contract.is_none()) {
+      const Manifest m = split_manifest(*split);
+      const auto n = static_cast<std::int64_t>(m.test().size());
+      if (index < 0 || index >= n)
+        throw InputError(*split, "index", "out of range (the split has " + std::to_string(n) + " contracts, got " + std::to_string(index) + ")");
+      for (int i = 0; i < num_envs; ++i) contracts.push_back(m.test()[static_cast<std::size_t>((index + i) % n)].contract);
+    } else {
+      contracts.assign(static_cast<std::size_t>(num_envs), pick_contract(contract, split, index));
+    }
+    for (const auto& c : contracts) envs_.emplace_back(model_, c, rot);
+    seeds_.assign(static_cast<std::size_t>(num_envs), 0);
+    if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
+    pool_ = std::make_unique<WorkerPool>(std::min<unsigned>(threads, static_cast<unsigned>(num_envs)));
+  }
+
+  int num_envs() const { return static_cast<int>(envs_.size()); }
+  int obs_dim() const { return model_->layout().size(); }
+  int horizon() const { return model_->horizon(); }
+  unsigned threads() const { return pool_->size(); }
+
+  py::tuple reset(std::optional<std::uint64_t> seed) {
+    const std::uint64_t base = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
+    const auto n = envs_.size();
+    DArray obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(obs_dim())});
+    double* out = obs.mutable_data();
+    {
+      py::gil_scoped_release release;
+      for_each_env([&](std::size_t i) {
+        seeds_[i] = base + i;
+        const Eigen::VectorXd& o = envs_[i].reset(seeds_[i]);
+        std::copy(o.data(), o.data() + o.size(), out + i * static_cast<std::size_t>(o.size()));
+      });
+    }
+    py::dict info;
+    info["seed"] = vec_u64(seeds_);
+    return py::make_tuple(obs, info);
+  }
+
+  py::tuple step(py::handle actions) {
+    DArray a = DArray::ensure(actions);
+    if (!a) {
+      PyErr_Clear();
+      value_error("actions: not convertible to an array of numbers");
+    }
+    const auto n = envs_.size();
+    if (a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(n) || a.shape(1) != kActionDim)
+      value_error("actions: must have shape (" + std::to_string(n) + ", 7) (got " + shape_of(a) + ")");
+    const auto d = static_cast<std::size_t>(obs_dim());
+    DArray obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(d)});
+    DArray final_obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(d)});
+    py::array_t<double> reward(static_cast<py::ssize_t>(n));
+    py::array_t<bool> term(static_cast<py::ssize_t>(n)), trunc(static_cast<py::ssize_t>(n)), success(static_cast<py::ssize_t>(n)),
+        success_once(static_cast<py::ssize_t>(n)), ended(static_cast<py::ssize_t>(n));
+    std::vector<sim::SafetyFlag> flags(n);
+    const double* in = a.data();
+    double* o = obs.mutable_data();
+    double* fo = final_obs.mutable_data();
+    double* rw = reward.mutable_data();
+    bool* te = term.mutable_data();
+    bool* tr = trunc.mutable_data();
+    bool* su = success.mutable_data();
+    bool* so = success_once.mutable_data();
+    bool* en = ended.mutable_data();
+    {
+      py::gil_scoped_release release;
+      for_each_env([&](std::size_t i) {
+        const sim::StepResult& r = envs_[i].step(std::span<const double>(in + i * kActionDim, kActionDim));
+        flags[i] = r.safety;
+        const bool safety = r.safety != sim::SafetyFlag::kNone;
+        rw[i] = r.reward;
+        te[i] = r.terminated || safety;
+        tr[i] = r.truncated && !safety;
+        su[i] = r.success;
+        so[i] = envs_[i].episode().success_once;
+        en[i] = te[i] || tr[i];
+        std::copy(r.obs.data(), r.obs.data() + d, fo + i * d);
+        if (en[i]) {
+          seeds_[i] = eval::splitmix64(seeds_[i]);
+          const Eigen::VectorXd& first = envs_[i].reset(seeds_[i]);
+          std::copy(first.data(), first.data() + d, o + i * d);
+        } else {
+          std::copy(r.obs.data(), r.obs.data() + d, o + i * d);
+        }
+      });
+    }
+    py::dict info;
+    info["success"] = success;
+    info["success_once"] = success_once;
+    py::list names;
+    for (auto f : flags) names.append(std::string(sim::safety_flag_name(f)));
+    info["safety"] = names;
+    info["final_obs"] = final_obs;
+    info["autoreset"] = ended;
+    return py::make_tuple(obs, reward, term, trunc, info);
+  }
+
+ private:
+  template <typename F>
+  void for_each_env(F&& f) {
+    const std::size_t n = envs_.size();
+    const unsigned t = pool_->size();
+    const std::function<void(unsigned)> chunk = [&](unsigned w) {
+      for (std::size_t i = w; i < n; i += t) f(i);
+    };
+    pool_->run(chunk);
+  }
+  static py::array_t<std::uint64_t> vec_u64(const std::vector<std::uint64_t>& v) {
+    py::array_t<std::uint64_t> out(static_cast<py::ssize_t>(v.size()));
+    std::copy(v.begin(), v.end(), out.mutable_data());
+    return out;
+  }
+  std::shared_ptr<const sim::EnvModel> model_;
+  std::vector<sim::HiddenContractEnv> envs_;
+  std::vector<std::uint64_t> seeds_;
+  std::optional<std::uint64_t> last_seed_;
+  std::unique_ptr<WorkerPool> pool_;
+};
+
+// The C++ baseline of the per-step benchmark (tests/bench/python_bench.py): the same control loop
+// as stepping an Env from Python (identity contract, reset with seed, seed+1, ... at each episode
+// end), over the rows of `actions`, in C++. Returns the wall time [s] of the loop.
+double bench_cpp_steps(const std::string& task, const DArray& actions, std::uint64_t seed, const std::string& profile) {
+  if (actions.ndim() != 2 || actions.shape(1) != kActionDim) value_error("actions: must have shape (N, 7)");
+  sim::HiddenContractEnv env(env_model(sim::parse_task(task), profile), Contract::identity());
+  const double* a = actions.data();
+  const auto n = static_cast<std::size_t>(actions.shape(0));
+  py::gil_scoped_release release;
+  const auto t0 = std::chrono::steady_clock::now();
+  env.reset(seed);
+  double sink = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const sim::StepResult& r = env.step(std::span<const double>(a + i * kActionDim, kActionDim));
+    sink += r.obs[0];
+    if (r.episode_over()) env.reset(++seed);
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  if (!std::isfinite(sink)) return -1.0;
+  return std::chrono::duration<double>(t1 - t0).count();
+}
+
+// ---------------------------------------------------------------- in-process backbone
+
+// A Python callable obs -> 7 numbers as a policy::Policy. reset() calls the object's `reset()`
+// method if it has one. Every clone shares the one Python object, so run it with one thread.
+class PythonPolicy final : public policy::Policy {
+ public:
+  PythonPolicy(py::object fn, std::string name, std::string sha256, sim::TaskId task)
+      : fn_(std::make_shared<py::object>(std::move(fn))), name_(std::move(name)), sha_(std::move(sha256)), task_(task) {}
+  ~PythonPolicy() override {
+    py::gil_scoped_acquire gil;
+    fn_.reset();
+  }
+  void reset() override {
+    py::gil_scoped_acquire gil;
+    if (py::hasattr(*fn_, "reset")) fn_->attr("reset")();
+  }
+  Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override {
+    policy::check_observation(obs, task_);
+    py::gil_scoped_acquire gil;
+    py::object out = (*fn_)(vec_out(obs.data(), obs.size()));
+    Action a = to_vec<kActionDim>(out, "policy output");
+    return a;
+  }
+  std::string name() const override { return name_; }
+  std::string sha256() const override { return sha_; }
+  sim::TaskId task() const override { return task_; }
+  std::unique_ptr<policy::Policy> clone() const override {
+    py::gil_scoped_acquire gil;
+    return std::make_unique<PythonPolicy>(*fn_, name_, sha_, task_);
+  }
+
+ private:
+  std::shared_ptr<py::object> fn_;
+  std::string name_, sha_;
+  sim::TaskId task_;
+};
+
+// backbone identity of a Python policy: "external:<command>" hashes the command exactly as the
+// external-process backbone does (so the job is the one `actionshift run --backbone` writes);
+// any other name is hashed as a whole.
+eval::BackboneRef backbone_ref(const std::string& name) {
+  if (name.empty()) throw InputError("evaluate", "backbone", "must not be empty");
+  static constexpr std::string_view kExternal = "external:";
+  if (name.rfind(kExternal, 0) == 0) {
+    const std::string command = name.substr(kExternal.size());
+    if (command.empty()) throw InputError("evaluate", "backbone", "external: needs a command");
+    return {name, sha256_hex(command)};
+  }
+  return {name, sha256_hex(name)};
+}
+
+py::dict evaluate(py::object policy, const std::string& task, const std::string& split, const std::string& method,
+                  std::uint64_t seed, std::int64_t episodes, const std::string& out, const std::string& backbone,
+                  std::optional<std::string> pool, py::object params, const std::string& rotation,
+                  const std::string& profile, const std::string& progress) {
+  if (!PyCallable_Check(policy.ptr())) throw py::type_error("policy: must be callable (obs -> 7 numbers)");
+  env_config_for_profile(profile);  // only the default profile enters jobs in this build
+  eval::JobRequest q;
+  q.task = task;
+  q.split = split;
+  q.method.name = method;
+  q.method.params = params.is_none() ? "{}" : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params));
+  q.backbone = backbone;
+  q.pool = pool;
+  q.rotation_mode = rotation;
+  q.seed = seed;
+  q.episodes = episodes;
+  eval::PlanResolver resolver = eval::default_resolver();
+  resolver.backbone = [](const std::string&, const std::string& name) { return backbone_ref(name); };
+  const eval::JobSpec job = eval::resolve_job(q, resolver);
+  auto prototype = std::make_shared<PythonPolicy>(policy, job.backbone.name, job.backbone.sha256, sim::parse_task(task));
+  eval::RunOptions ro;
+  ro.threads = 1;  // one Python callable: its calls are serialised by the GIL anyway
+  ro.out_dir = out;
+  if (progress == "off") ro.progress = eval::ProgressMode::off;
+  else if (progress == "lines") ro.progress = eval::ProgressMode::lines;
+  else if (progress == "bar") ro.progress = eval::ProgressMode::bar;
+  else if (progress == "auto") ro.progress = eval::ProgressMode::automatic;
+  else throw InputError("progress", "", "expected auto, bar, lines or off (got \"" + progress + "\")");
+  eval::RunResult r;
+  {
+    const eval::EpisodeFn fn = eval::make_episode_fn(job, prototype);
+    py::gil_scoped_release release;
+    r = eval::run_job(job, fn, ro);
+  }
+  py::dict d;
+  d["job_id"] = r.job_id;
+  d["jsonl_path"] = r.jsonl_path;
+  d["summary_path"] = r.summary_path;
+  d["episodes_total"] = r.episodes_total;
+  d["episodes_before"] = r.episodes_before;
+  d["episodes_run"] = r.episodes_run;
+  d["already_complete"] = r.already_complete;
+  d["wall_time_s"] = r.wall_time_s;
+  d["job"] = json_to_py(eval::job_canonical_json(job));
+  return d;
+}
+
+// ---------------------------------------------------------------- adapters
+
+// an adapter by method name, with its task's calibration and (for pool methods) a pool
+std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
+                                             py::object truth, py::object params) {
+  const nlohmann::json p = adapt::resolve_method_params(
+      method, nlohmann::json::parse(params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params)),
+                                    nullptr, false));
+  struct Holder {
+    std::vector<Contract> pool;
+    std::optional<Contract> truth;
+    std::optional<adapt::ResponseModel> model;
+  } h;
+  adapt::MethodInputs in;
+  if (!pool.is_none()) {
+    h.pool = to_contracts(pool, "pool");
+    in.pool = &h.pool;
+  }
+  if (!truth.is_none()) {
+    h.truth = to_contract(truth);
+    in.truth = &*h.truth;
+  }
+  if (adapt::method_needs_calibration(method)) {
+    h.model = eval::builtin_calibration(std::string(sim::task_name(sim::parse_task(task)))).model();
+    in.model = &*h.model;
+  }
+  return adapt::make_adapter(method, p, in);  // adapters copy what they keep
+}
+
+adapt::TcpSlice slice_of(const std::string& task) {
+  return eval::tcp_slice(sim::observation_layout(sim::parse_task(task)));
+}
+
+std::vector<double> obs_vector(py::handle h, const adapt::TcpSlice& s, const char* what) {
+  DArray a = as_array(h, what);
+  if (a.ndim() != 1 || a.shape(0) < s.quaternion_start + 4)
+    value_error(std::string(what) + ": not an observation of this task (got shape " + shape_of(a) + ")");
+  return {a.data(), a.data() + a.shape(0)};
+}
+
+// ---------------------------------------------------------------- self-test
+
+selftest::TcpPose to_tcp_pose(py::handle position, py::handle quaternion, py::handle fingers) {
+  selftest::TcpPose p;
+  p.position = to_vec<3>(position, "position");
+  p.quaternion = to_vec<4>(quaternion, "quaternion");
+  if (!fingers.is_none()) p.fingers = to_vec<2>(fingers, "fingers");
+  return p;
+}
+
+class PySelfTest {
+ public:
+  PySelfTest(py::object expected, py::object pool, py::object model, const std::string& strategy, int budget,
+             double amplitude, double confidence_floor, double misspec_ratio, const std::string& frame_rotation,
+             const std::string& task)
+      : task_(task) {
+    selftest::Options o;
+    if (!expected.is_none()) o.expected = to_contract(expected);
+    if (!pool.is_none()) o.pool = to_contracts(pool, "pool");
+    if (!model.is_none()) {
+      if (py::isinstance<py::str>(model)) {
+        o.model = eval::builtin_calibration(model.cast<std::string>()).model();
+      } else {
+        const auto alpha = to_vec<kPoseDim>(model["alpha"], "model.alpha");
+        const auto sigma = to_vec<kPoseDim>(model["sigma"], "model.sigma");
+        std::copy(alpha.data(), alpha.data() + kPoseDim, o.model.alpha.begin());
+        std::copy(sigma.data(), sigma.data() + kPoseDim, o.model.sigma.begin());
+      }
+    }
+    if (strategy == "entropy") o.strategy = selftest::Strategy::kEntropy;
+    else if (strategy == "fixed") o.strategy = selftest::Strategy::kFixed;
+    else throw InputError("selftest options", "strategy", "expected 'entropy' or 'fixed' (got '" + strategy + "')");
+    o.budget = budget;
+    o.amplitude = amplitude;
+    o.confidence_floor = confidence_floor;
+    o.misspec_ratio = misspec_ratio;
+    if (frame_rotation == "measured") o.frame_rotation = selftest::FrameRotation::kMeasured;
+    else if (frame_rotation == "identity") o.frame_rotation = selftest::FrameRotation::kIdentity;
+    else throw InputError("selftest options", "frame_rotation", "expected 'measured' or 'identity' (got '" + frame_rotation + "')");
+    std::string err;
+    auto st = selftest::SelfTest::create(o, &err);
+    if (!st) throw std::invalid_argument(err);
+    st_ = std::make_unique<selftest::SelfTest>(std::move(*st));
+  }
+  void begin(py::handle position, py::handle quaternion, py::handle fingers) {
+    st_->begin(to_tcp_pose(position, quaternion, fingers));
+  }
+  py::object next_probe() {
+    const auto p = st_->next_probe();
+    if (!p) return py::none();
+    return vec_out(*p);
+  }
+  void observe(py::handle position, py::handle quaternion, py::handle fingers) {
+    st_->observe(to_tcp_pose(position, quaternion, fingers));
+  }
+  bool done() const { return st_->done(); }
+  int probes_observed() const { return st_->probes_observed(); }
+  std::vector<Contract> pool() const { return st_->pool(); }
+  DArray posterior() const { return vec_out(st_->posterior()); }
+  selftest::ReportHeader header() const {
+    selftest::ReportHeader h;
+    h.task = task_;
+    h.backend = "python";
+    h.strategy = selftest::to_string(st_->options().strategy);
+    h.budget = st_->options().budget;
+    h.pool_size = static_cast<int>(st_->pool().size());
+    return h;
+  }
+  py::object verdict() const { return json_to_py(selftest::to_json(st_->verdict(), header())); }
+  std::string report() const { return selftest::to_text(st_->verdict(), header()); }
+
+ private:
+  std::string task_;
+  std::unique_ptr<selftest::SelfTest> st_;
+};
+
+// ---------------------------------------------------------------- manifests
+
+py::dict check_dict(const Check& c) {
+  py::dict d;
+  d["name"] = c.name;
+  d["ok"] = c.ok;
+  d["detail"] = c.detail;
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "ActionShift native core (use the `actionshift` package)";
+
+  // errors: InputError -> actionshift.InputError (a ValueError) with the one-line message and its parts
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      py::object exc = py::handle(input_error.ptr())(e.what());
+      exc.attr("source") = e.source();
+      exc.attr("field") = e.field();
+      exc.attr("reason") = e.reason();
+      PyErr_SetObject(input_error.ptr(), exc.ptr());
+    }
+  });
+
+  // ---- contracts and the core
+  py::class_<Contract>(m, "Contract", "An immutable action contract (see docs/splits.md).")
+      .def(py::init([](std::vector<long long> permutation, std::vector<long long> sign, std::vector<double> scale,
+                       std::string target, std::string frame, long long lag, bool gripper_inverted) {
+             ContractFields f{std::move(permutation), std::move(sign), std::move(scale), std::move(target),
+                              std::move(frame), lag, gripper_inverted};
+             std::string err;
+             auto c = Contract::try_make(f, &err);
+             if (!c) throw InputError("contract", "", err);
+             return *c;
+           }),
+           py::arg("permutation") = std::vector<long long>{0, 1, 2, 3, 4, 5},
+           py::arg("sign") = std::vector<long long>{1, 1, 1, 1, 1, 1},
+           py::arg("scale") = std::vector<double>{1, 1, 1, 1, 1, 1}, py::arg("target") = "delta",
+           py::arg("frame") = "base", py::arg("lag") = 0, py::arg("gripper_inverted") = false)
+      .def_static("identity", &Contract::identity)
+      .def_static("from_json", [](py::handle h) { return to_contract(h); }, py::arg("json"),
+                  "From JSON text or a dict; raises ValueError (actionshift.InputError) with the reason.")
+      .def("to_json", &Contract::to_json, "Canonical JSON (the hash input).")
+      .def("to_dict", [](const Contract& c) { return json_to_py(c.to_json()); })
+      .def("hash", &Contract::sha256, "Lowercase hex SHA-256 of the canonical JSON (= `actionshift contract hash`).")
+      .def_property_readonly("sha256", &Contract::sha256)
+      .def_property_readonly("permutation", &Contract::permutation)
+      .def_property_readonly("sign", &Contract::sign)
+      .def_property_readonly("scale", &Contract::scale)
+      .def_property_readonly("target", [](const Contract& c) { return std::string(to_string(c.target())); })
+      .def_property_readonly("frame", [](const Contract& c) { return std::string(to_string(c.frame())); })
+      .def_property_readonly("lag", &Contract::lag)
+      .def_property_readonly("gripper_inverted", &Contract::gripper_inverted)
+      .def("composition_signature", &Contract::composition_signature)
+      .def("__eq__", [](const Contract& a, const Contract& b) { return a == b; })
+      .def("__hash__", [](const Contract& c) { return py::hash(py::str(c.sha256())); })
+      .def("__repr__", [](const Contract& c) { return "Contract.from_json('" + c.to_json() + "')"; });
+
+  m.def("decode", [](py::handle c, py::handle raw, py::handle R, py::handle target) {
+        return vec_out(decode(to_contract(c), to_vec<kActionDim>(raw, "raw"), to_rotation(R, "R"), to_target(target)));
+      }, py::arg("contract"), py::arg("raw"), py::arg("R") = py::none(), py::arg("tracked_target") = py::none(),
+      "Canonical action (7) that a raw action decodes to (stateless; lag is the Decoder's).");
+  m.def("encode", [](py::handle c, py::handle canonical, py::handle R, py::handle target) {
+        return vec_out(encode(to_contract(c), to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R"), to_target(target)));
+      }, py::arg("contract"), py::arg("canonical"), py::arg("R") = py::none(), py::arg("tracked_target") = py::none(),
+      "Raw action (7) that decodes to `canonical` (the inverse of decode).");
+  m.def("decode_jacobian", [](py::handle c, py::handle R) {
+        const ActionJacobian J = decode_jacobian(to_contract(c), to_rotation(R, "R"));
+        DArray out({kActionDim, kActionDim});
+        for (int i = 0; i < kActionDim; ++i)
+          for (int j = 0; j < kActionDim; ++j) out.mutable_at(i, j) = J(i, j);
+        return out;
+      }, py::arg("contract"), py::arg("R") = py::none());
+  m.def("pool_sha256", [](py::handle contracts) { return pool_sha256(to_contracts(contracts, "contracts")); },
+        py::arg("contracts"));
+
+  py::class_<Decoder>(m, "Decoder", "Stateful decoder (tracked target + lag FIFO) over num_envs environments.")
+      .def(py::init([](py::handle c, int num_envs) { return Decoder(to_contract(c), num_envs); }), py::arg("contract"),
+           py::arg("num_envs") = 1)
+      .def_property_readonly("contract", &Decoder::contract)
+      .def_property_readonly("num_envs", &Decoder::num_envs)
+      .def("reset", [](Decoder& d, std::optional<int> env) {
+             if (env) d.reset(*env);
+             else d.reset_all();
+           }, py::arg("env") = py::none())
+      .def("tracked_target", [](const Decoder& d, int env) { return vec_out(d.tracked_target(env)); }, py::arg("env") = 0)
+      .def("step", [](Decoder& d, py::handle raw, py::handle R, bool reset) {
+             return vec_out(d.step(to_vec<kActionDim>(raw, "raw"), to_rotation(R, "R"), reset));
+           }, py::arg("raw"), py::arg("R") = py::none(), py::arg("reset") = false,
+           "One environment: the canonical action handed to the controller (after the lag FIFO).")
+      .def("step_batch", [](Decoder& d, py::handle raw, py::handle R, py::handle reset_mask) {
+             DArray a = as_array(raw, "raw");
+             const int n = d.num_envs();
+             if (a.ndim() != 2 || a.shape(0) != n || a.shape(1) != kActionDim)
+               value_error("raw: must have shape (" + std::to_string(n) + ", 7) (got " + shape_of(a) + ")");
+             Decoder::Batch in(kActionDim, n), out(kActionDim, n);
+             for (int e = 0; e < n; ++e)
+               for (int k = 0; k < kActionDim; ++k) in(k, e) = a.at(e, k);
+             std::vector<Mat3> rs;
+             if (!R.is_none()) {
+               DArray r = as_array(R, "R");
+               if (r.ndim() == 2) rs.push_back(to_rotation(r, "R"));
+               else if (r.ndim() == 3 && r.shape(0) == n) {
+                 for (int e = 0; e < n; ++e) rs.push_back(to_rotation(r[py::int_(e)], "R"));
+               } else value_error("R: must be None, 3x3 or (" + std::to_string(n) + ", 3, 3) (got " + shape_of(r) + ")");
+             }
+             std::unique_ptr<bool[]> mask;
+             std::span<const bool> mask_span;
+             if (!reset_mask.is_none()) {
+               const auto v = reset_mask.cast<std::vector<bool>>();
+               if (static_cast<int>(v.size()) != n) value_error("reset_mask: must have " + std::to_string(n) + " flags");
+               mask = std::make_unique<bool[]>(v.size());
+               std::copy(v.begin(), v.end(), mask.get());
+               mask_span = {mask.get(), v.size()};
+             }
+             d.step(in, rs, mask_span, out);
+             DArray res({n, kActionDim});
+             for (int e = 0; e < n; ++e)
+               for (int k = 0; k < kActionDim; ++k) res.mutable_at(e, k) = out(k, e);
+             return res;
+           }, py::arg("raw"), py::arg("R") = py::none(), py::arg("reset_mask") = py::none(),
+           "All environments: raw (N, 7) -> canonical (N, 7).")
+      .def("preview", [](const Decoder& d, py::handle raw, py::handle R, int env) {
+             return vec_out(d.preview(to_vec<kActionDim>(raw, "raw"), to_rotation(R, "R"), env));
+           }, py::arg("raw"), py::arg("R") = py::none(), py::arg("env") = 0);
+
+  // ---- manifests and pools
+  py::class_<Manifest>(m, "Manifest", "A split manifest or contract pool (docs/splits.md).")
+      .def_property_readonly("name", &Manifest::name)
+      .def_property_readonly("kind", [](const Manifest& x) { return std::string(x.is_pool() ? "pool" : "split"); })
+      .def_property_readonly("rule", &Manifest::rule)
+      .def_property_readonly("seed", &Manifest::seed)
+      .def_property_readonly("description", &Manifest::description)
+      .def_property_readonly("generator_version", &Manifest::generator_version)
+      .def_property_readonly("contracts", &Manifest::contracts, "Evaluation contracts (split) or members (pool), in order.")
+      .def_property_readonly("train", &Manifest::train_contracts)
+      .def_property_readonly("manifest_sha256", &Manifest::manifest_sha256, "The hash written in the file.")
+      .def("computed_sha256", &Manifest::computed_sha256, "The hash of the body as it is (validate compares the two).")
+      .def_property_readonly("pool_sha256", [](const Manifest& x) -> py::object {
+        if (!x.is_pool()) return py::none();
+        return py::str(x.pool_sha256());
+      })
+      .def("validate", [](const Manifest& x, bool regenerate) {
+             py::list out;
+             for (const auto& c : validate(x, regenerate)) out.append(check_dict(c));
+             return out;
+           }, py::arg("regenerate") = true, "The checks of `actionshift validate` for this manifest.")
+      .def("__len__", [](const Manifest& x) { return x.test().size(); })
+      .def("__repr__", [](const Manifest& x) {
+        return "<actionshift.Manifest " + x.name() + " (" + (x.is_pool() ? "pool" : "split") + ", " +
+               std::to_string(x.test().size()) + " contracts)>";
+      });
+  m.def("load_manifest", &data::resolve_manifest, py::arg("name_or_path"),
+        "A manifest file, or a built-in split or pool by name.");
+  m.def("builtin_manifests", &data::builtin_manifest_names);
+
+  // ---- environments
+  py::class_<PyEnv>(m, "_Env")
+      .def(py::init<const std::string&, py::handle, std::optional<std::string>, std::int64_t, const std::string&, const std::string&>(),
+           py::arg("task"), py::arg("contract"), py::arg("split"), py::arg("index"), py::arg("rotation"), py::arg("profile"))
+      .def("reset", &PyEnv::reset, py::arg("seed") = py::none())
+      .def("step", &PyEnv::step, py::arg("action"))
+      .def_property_readonly("task", &PyEnv::task)
+      .def_property_readonly("horizon", &PyEnv::horizon)
+      .def_property_readonly("obs_dim", &PyEnv::obs_dim)
+      .def_property_readonly("layout", &PyEnv::layout)
+      .def_property_readonly("profile", &PyEnv::profile)
+      .def_property_readonly("rotation", &PyEnv::rotation);
+  py::class_<PyVecEnv>(m, "_VecEnv")
+      .def(py::init<const std::string&, int, py::handle, std::optional<std::string>, std::int64_t, const std::string&,
+                    const std::string&, unsigned>(),
+           py::arg("task"), py::arg("num_envs"), py::arg("contract"), py::arg("split"), py::arg("index"),
+           py::arg("rotation"), py::arg("profile"), py::arg("threads"))
+      .def("reset", &PyVecEnv::reset, py::arg("seed") = py::none())
+      .def("step", &PyVecEnv::step, py::arg("actions"))
+      .def_property_readonly("num_envs", &PyVecEnv::num_envs)
+      .def_property_readonly("obs_dim", &PyVecEnv::obs_dim)
+      .def_property_readonly("horizon", &PyVecEnv::horizon)
+      .def_property_readonly("threads", &PyVecEnv::threads);
+  m.def("tasks", [] {
+    std::vector<std::string> out;
+    for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t));
+    return out;
+  });
+  m.def("_bench_cpp_steps", &bench_cpp_steps, py::arg("task"), py::arg("actions"), py::arg("seed"),
+        py::arg("profile") = "maniskill");
+  m.def("env_config_check", [](const std::string& profile) { env_config_for_profile(profile); }, py::arg("profile"));
+
+  // ---- adapters
+  py::class_<adapt::Adapter>(m, "Adapter", "An adapter: begin_episode / encode / observe (docs/adapters.md).")
+      .def_property_readonly("name", &adapt::Adapter::name)
+      .def("begin_episode", &adapt::Adapter::begin_episode, py::arg("episode_seed"))
+      .def("encode", [](adapt::Adapter& a, py::handle canonical, py::handle R) {
+             return vec_out(a.encode(to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R")));
+           }, py::arg("canonical"), py::arg("R") = py::none())
+      .def("observe", [](adapt::Adapter& a, py::handle raw, py::handle response, py::handle R) {
+             a.observe(to_vec<kActionDim>(raw, "raw"), to_vec<kPoseDim>(response, "response"), to_rotation(R, "R"));
+           }, py::arg("raw"), py::arg("response"), py::arg("R") = py::none())
+      .def_property_readonly("last_probe", [](const adapt::Adapter& a) { return a.last_step().probe; })
+      .def_property_readonly("last_task_regret", [](const adapt::Adapter& a) { return a.last_step().task_regret; });
+  m.def("_make_adapter", &make_adapter, py::arg("method"), py::arg("task"), py::arg("pool"), py::arg("truth"),
+        py::arg("params"));
+  m.def("methods", &adapt::method_names);
+  m.def("method_needs_pool", &adapt::method_needs_pool, py::arg("method"));
+  m.def("method_needs_calibration", &adapt::method_needs_calibration, py::arg("method"));
+  m.def("method_params", [](const std::string& method, py::object params) {
+        return json_to_py(eval::resolved_method_params(method, params.is_none() ? "{}" : py_to_json(params)));
+      }, py::arg("method"), py::arg("params") = py::none(), "The method's parameters with every default filled in.");
+  m.def("tcp_rotation", [](py::handle obs, const std::string& task) {
+        const auto s = slice_of(task);
+        return mat_out(adapt::tcp_rotation(obs_vector(obs, s, "obs"), s));
+      }, py::arg("obs"), py::arg("task"), "The TCP orientation in an observation (the R adapters take under `live`).");
+  m.def("tcp_response", [](py::handle prev, py::handle cur, const std::string& task) {
+        const auto s = slice_of(task);
+        return vec_out(adapt::tcp_response(obs_vector(prev, s, "prev_obs"), obs_vector(cur, s, "obs"), s));
+      }, py::arg("prev_obs"), py::arg("obs"), py::arg("task"), "The TCP response (6) between two observations.");
+
+  // ---- evaluation
+  m.def("_evaluate", &evaluate, py::arg("policy"), py::arg("task"), py::arg("split"), py::arg("method"), py::arg("seed"),
+        py::arg("episodes"), py::arg("out"), py::arg("backbone"), py::arg("pool"), py::arg("params"),
+        py::arg("rotation"), py::arg("profile"), py::arg("progress"));
+  m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec)), "job")); },
+        py::arg("job"));
+
+  // ---- self-test
+  py::class_<PySelfTest>(m, "SelfTest", "Plug-and-verify with the control loop inverted (docs/selftest.md).")
+      .def(py::init<py::object, py::object, py::object, const std::string&, int, double, double, double,
+                    const std::string&, const std::string&>(),
+           py::arg("expected") = py::none(), py::arg("pool") = py::none(), py::arg("model") = py::none(),
+           py::arg("strategy") = "entropy", py::arg("budget") = 6, py::arg("amplitude") = 0.5,
+           py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "measured",
+           py::arg("task") = "custom")
+      .def("begin", &PySelfTest::begin, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
+      .def("next_probe", &PySelfTest::next_probe, "The next raw 7-vector to send, or None once the budget is spent.")
+      .def("observe", &PySelfTest::observe, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
+      .def_property_readonly("done", &PySelfTest::done)
+      .def_property_readonly("probes_observed", &PySelfTest::probes_observed)
+      .def_property_readonly("pool", &PySelfTest::pool)
+      .def("posterior", &PySelfTest::posterior)
+      .def("verdict", &PySelfTest::verdict, "The verdict as a dict (the JSON report of `actionshift selftest --json`).")
+      .def("report", &PySelfTest::report, "The human report.");
+  m.def("selftest_library", [] {
+    std::vector<std::pair<std::string, Contract>> out;
+    for (const auto& n : selftest::library()) out.emplace_back(n.name, n.contract);
+    return out;
+  });
+}

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Benchmarks of the Python module (docs/results/benchmarks.md, "Python"):
+
+1. per control step: stepping an actionshift.Env from a Python loop vs the same loop in C++
+   (actionshift._native._bench_cpp_steps: same task, same action rows, same reset seeds);
+2. one job: actionshift.evaluate() of a trivial policy in process vs `actionshift run` with the same
+   policy as an external JSON-lines process (a standard-library-only server, the fastest form).
+
+Medians over --runs runs. Usage (from the repository root, after the build):
+    PYTHONPATH=build/python python3 tests/bench/python_bench.py --cli build/apps/actionshift/actionshift
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import actionshift
+from actionshift import _native
+
+TRIVIAL_SERVER = r'''
+import sys
+for line in sys.stdin:
+    if '"type":"hello"' in line:
+        sys.stdout.write('{"type":"ready"}\n'); sys.stdout.flush()
+    elif '"type":"step"' in line:
+        sys.stdout.write('{"action":[0.0,0.0,0.0,0.0,0.0,0.0,0.0]}\n'); sys.stdout.flush()
+'''
+
+
+def zero_policy(obs):
+    return np.zeros(7)
+
+
+def bench_steps(task, steps, runs):
+    rng = np.random.default_rng(1)
+    actions = rng.uniform(-1.0, 1.0, size=(steps, 7))
+    env = actionshift.make(task)
+    cpp, py = [], []
+    for _ in range(runs):
+        cpp.append(_native._bench_cpp_steps(task, actions, 100) / steps)
+        seed = 100
+        t0 = time.perf_counter()
+        env.reset(seed=seed)
+        for a in actions:
+            obs, reward, terminated, truncated, info = env.step(a)
+            if truncated or info["safety"] != "none":
+                seed += 1
+                env.reset(seed=seed)
+        py.append((time.perf_counter() - t0) / steps)
+    return statistics.median(cpp), statistics.median(py), cpp, py
+
+
+def bench_evaluate(cli, episodes, runs, threads):
+    inproc, external = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        server = os.path.join(tmp, "zero_server.py")
+        with open(server, "w") as f:
+            f.write(TRIVIAL_SERVER)
+        backbone = f"external:{sys.executable} {server}"
+        for k in range(runs):
+            out = os.path.join(tmp, f"inproc{k}")
+            t0 = time.perf_counter()
+            r = actionshift.evaluate(zero_policy, task="pick_cube", split="seen", method="no_adapt", seed=k,
+                                     episodes=episodes, out=out, backbone=backbone)
+            inproc.append(time.perf_counter() - t0)
+            out2 = os.path.join(tmp, f"external{k}")
+            t0 = time.perf_counter()
+            subprocess.run([cli, "run", "--task", "pick_cube", "--split", "seen", "--method", "no_adapt",
+                            "--seed", str(k), "--episodes", str(episodes), "--backbone", backbone, "--out", out2,
+                            "--progress", "off", "--threads", str(threads)], check=True, capture_output=True)
+            external.append(time.perf_counter() - t0)
+            a = open(os.path.join(out, r["job_id"] + ".jsonl"), "rb").read()
+            b = open(os.path.join(out2, r["job_id"] + ".jsonl"), "rb").read()
+            assert a == b, "in-process and external JSONL differ"
+    return statistics.median(inproc), statistics.median(external), inproc, external
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--cli", required=True, help="the actionshift binary")
+    ap.add_argument("--task", default="pick_cube")
+    ap.add_argument("--steps", type=int, default=2000, help="control steps per step-cost run")
+    ap.add_argument("--episodes", type=int, default=32, help="episodes per evaluation run")
+    ap.add_argument("--runs", type=int, default=5, help="runs per figure (medians)")
+    ap.add_argument("--threads", type=int, default=1, help="--threads of the CLI run (in process: 1)")
+    ap.add_argument("--json", action="store_true", help="print one JSON object")
+    a = ap.parse_args()
+    cpp, py, cpp_runs, py_runs = bench_steps(a.task, a.steps, a.runs)
+    ev_in, ev_ext, in_runs, ext_runs = bench_evaluate(a.cli, a.episodes, a.runs, a.threads)
+    result = {
+        "task": a.task, "steps": a.steps, "runs": a.runs,
+        "cpp_us_per_step": cpp * 1e6, "python_us_per_step": py * 1e6, "python_overhead_pct": (py / cpp - 1) * 100,
+        "cpp_runs_us": [x * 1e6 for x in cpp_runs], "python_runs_us": [x * 1e6 for x in py_runs],
+        "episodes": a.episodes, "cli_threads": a.threads,
+        "evaluate_in_process_s": ev_in, "evaluate_external_s": ev_ext, "speedup": ev_ext / ev_in,
+        "in_process_runs_s": in_runs, "external_runs_s": ext_runs,
+    }
+    if a.json:
+        print(json.dumps(result, indent=2))
+        return
+    print(f"per control step ({a.task}, {a.steps} steps, median of {a.runs}): C++ {cpp * 1e6:.1f} us, "
+          f"Python {py * 1e6:.1f} us, overhead {result['python_overhead_pct']:+.1f} %")
+    print(f"evaluate ({a.episodes} episodes of a trivial policy, median of {a.runs}): in process {ev_in:.2f} s, "
+          f"external process (--threads {a.threads}) {ev_ext:.2f} s, speed-up {result['speedup']:.1f}x")
+
+
+if __name__ == "__main__":
+    main()

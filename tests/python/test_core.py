@@ -1,0 +1,112 @@
+"""Contracts, decoder, manifests and pools from Python, with hash parity against the CLI."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+import actionshift
+
+IDENTITY_SHA = "6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa"
+REFERENCE9_POOL_SHA = "b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3"
+
+
+def test_identity_contract_hash_and_json_round_trip():
+    c = actionshift.Contract.identity()
+    assert c.hash() == c.sha256 == IDENTITY_SHA
+    assert actionshift.Contract.from_json(c.to_json()) == c
+    assert actionshift.Contract.from_json(c.to_dict()) == c
+    lagged = actionshift.Contract(permutation=[1, 0, 2, 3, 4, 5], lag=2, target="absolute")
+    assert lagged.lag == 2 and lagged.target == "absolute" and list(lagged.permutation) == [1, 0, 2, 3, 4, 5]
+    assert lagged.composition_signature() == ["permutation", "target", "lag"]
+    assert lagged != c and len({c, lagged, actionshift.Contract()}) == 2
+
+
+def test_contract_hashes_equal_the_cli(cli):
+    contracts = actionshift.load_manifest("seen").contracts + actionshift.load_manifest("reference9").contracts
+    lines = "".join(json.dumps({"contract": c.to_dict()}) + "\n" for c in contracts)
+    out = cli("contract", "hash", stdin=lines, check=0).stdout.split()
+    cli_hashes = [json.loads(line)["sha256"] for line in out]
+    assert cli_hashes == [c.hash() for c in contracts]
+    assert len(set(cli_hashes)) == len(contracts)
+
+
+def test_manifest_and_pool_hashes_equal_cli_validate(cli, source_dir):
+    report = json.loads(cli("validate", "--json", os.path.join(source_dir, "manifests"), check=0).stdout)
+    by_name = {m["name"]: m for m in report["manifests"]}
+    assert sorted(by_name) == actionshift.builtin_manifests()
+    for name, m in by_name.items():
+        py = actionshift.load_manifest(os.path.join(source_dir, "manifests", name + ".json"))
+        assert py.name == name and py.kind == m["kind"] and len(py) == m["contracts"]
+        assert py.manifest_sha256 == py.computed_sha256() == m["manifest_sha256"]
+        assert py.pool_sha256 == m["pool_sha256"]
+        assert all(c["ok"] for c in py.validate(regenerate=False))
+    pool = actionshift.load_manifest("reference9")
+    assert pool.pool_sha256 == REFERENCE9_POOL_SHA == actionshift.pool_sha256(pool.contracts)
+
+
+def test_tampered_manifest_fails_validation(tmp_path, source_dir):
+    text = open(os.path.join(source_dir, "manifests", "reference9.json")).read()
+    bad = tmp_path / "reference9.json"
+    bad.write_text(text.replace('"scale":[1.0', '"scale":[1.5', 1))
+    checks = {c["name"]: c["ok"] for c in actionshift.load_manifest(str(bad)).validate(regenerate=False)}
+    assert not all(checks.values())
+
+
+def test_decode_encode_match_the_cli(cli):
+    c = actionshift.Contract(permutation=[2, 0, 1, 3, 5, 4], sign=[1, -1, 1, 1, 1, -1],
+                             scale=[0.5, 1, 2, 1, 1, 1], frame="tool", gripper_inverted=True)
+    R = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    raw = np.array([0.1, -0.2, 0.3, 0.05, -0.4, 0.25, 0.7])
+    canonical = actionshift.decode(c, raw, R)
+    req = {"contract": c.to_dict(), "raw": raw.tolist(), "rotation": R.tolist()}
+    cli_out = json.loads(cli("contract", "decode", json.dumps(req), check=0).stdout)
+    assert np.allclose(canonical, cli_out["canonical"], rtol=0, atol=1e-15)
+    assert np.allclose(actionshift.encode(c, canonical, R), raw, atol=1e-12)
+    J = actionshift.decode_jacobian(c, R)
+    assert np.allclose(J @ raw, canonical, atol=1e-12)
+
+
+def test_decoder_lag_fifo_and_batch():
+    c = actionshift.Contract(lag=2)
+    d = actionshift.Decoder(c)
+    outs = [d.step(np.full(7, k + 1.0) * 0.1, reset=(k == 0)) for k in range(4)]
+    assert np.all(outs[0] == 0) and np.all(outs[1] == 0)
+    assert np.allclose(outs[2], 0.1) and np.allclose(outs[3], 0.2)
+    batch = actionshift.Decoder(actionshift.Contract(sign=[-1, 1, 1, 1, 1, 1]), num_envs=3)
+    raw = np.arange(21, dtype=float).reshape(3, 7) / 100
+    out = batch.step_batch(raw)
+    assert out.shape == (3, 7) and np.allclose(out[:, 0], -raw[:, 0]) and np.allclose(out[:, 1:], raw[:, 1:])
+
+
+def test_bad_contract_raises_value_error_with_the_cli_message(cli):
+    bad = {"frame": "base", "gripper_inverted": False, "lag": 0, "permutation": [0, 0, 2, 3, 4, 5],
+           "scale": [1.0] * 6, "sign": [1] * 6, "target": "delta"}
+    with pytest.raises(ValueError) as e:
+        actionshift.Contract.from_json(bad)
+    assert isinstance(e.value, actionshift.InputError)
+    assert e.value.reason == "permutation must be a bijection over component indices"
+    p = cli("contract", "hash", json.dumps({"contract": bad}))
+    assert p.returncode == 2
+    line = p.stderr.strip()
+    assert line.startswith("actionshift: error: ") and line.endswith(str(e.value)), (line, str(e.value))
+    for text in ["{not json", '{"lag": 1}', "[]"]:
+        with pytest.raises(ValueError):
+            actionshift.Contract.from_json(text)
+    with pytest.raises(ValueError, match="scale values must be finite and positive"):
+        actionshift.Contract(scale=[1, 1, 0, 1, 1, 1])
+    with pytest.raises(ValueError, match="raw: must be 7 numbers"):
+        actionshift.decode(actionshift.Contract(), [1, 2, 3])
+    with pytest.raises(ValueError, match="not orthonormal"):
+        actionshift.decode(actionshift.Contract(), np.zeros(7), np.ones((3, 3)))
+
+
+def test_bad_manifest_file_raises_the_cli_message(tmp_path, cli):
+    bad = tmp_path / "broken.json"
+    bad.write_text('{"schema_version": "9"}')
+    with pytest.raises(ValueError) as e:
+        actionshift.load_manifest(str(bad))
+    p = cli("validate", str(bad))
+    assert p.returncode == 2
+    assert p.stderr.strip() == "actionshift: error: " + str(e.value)
+    assert e.value.source == str(bad)

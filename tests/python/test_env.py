@@ -1,0 +1,129 @@
+"""The Gymnasium API contract of actionshift.make(): types, shapes, spaces, seeding, horizon, safety."""
+import math
+
+import numpy as np
+import pytest
+
+import actionshift
+
+
+def test_reset_returns_observation_of_the_declared_space():
+    env = actionshift.make("pick_cube")
+    obs, info = env.reset(seed=1)
+    assert isinstance(obs, np.ndarray) and obs.dtype == np.float64
+    assert obs.shape == env.observation_space.shape == (sum(f["width"] for f in env.layout),)
+    assert env.action_space.shape == (7,)
+    assert env.action_space.dtype == np.float64
+    assert np.all(env.action_space.low == -1.0) and np.all(env.action_space.high == 1.0)
+    assert np.all(np.isinf(env.observation_space.low)) and np.all(np.isinf(env.observation_space.high))
+    assert isinstance(info, dict) and info["seed"] == 1 and info["elapsed_steps"] == 0
+    assert env.horizon == 50
+
+
+def test_same_seed_same_observation_other_seed_other_observation():
+    a = actionshift.make("pick_cube")
+    b = actionshift.make("pick_cube")
+    oa, _ = a.reset(seed=7)
+    ob, _ = b.reset(seed=7)
+    assert np.array_equal(oa, ob)
+    oc, _ = b.reset(seed=8)
+    assert not np.array_equal(oa, oc)
+    # seed=None continues a reproducible sequence
+    a.reset(seed=5)
+    n1, i1 = a.reset()
+    a.reset(seed=5)
+    n2, i2 = a.reset()
+    assert np.array_equal(n1, n2) and i1["seed"] == i2["seed"] != 5
+    # trajectories are deterministic too
+    act = np.array([0.3, -0.2, 0.1, 0.0, 0.0, 0.2, 1.0])
+    for env in (a, b):
+        env.reset(seed=11)
+    for _ in range(5):
+        ra, rb = a.step(act), b.step(act)
+        assert np.array_equal(ra[0], rb[0]) and ra[1] == rb[1]
+
+
+def test_step_types_and_truncation_at_the_horizon():
+    env = actionshift.make("push_cube")
+    env.reset(seed=3)
+    for t in range(1, env.horizon + 1):
+        obs, reward, terminated, truncated, info = env.step(np.zeros(7))
+        assert isinstance(obs, np.ndarray) and obs.shape == env.observation_space.shape
+        assert isinstance(reward, float) and 0.0 <= reward <= 1.0
+        assert isinstance(terminated, bool) and isinstance(truncated, bool)
+        assert set(info) >= {"success", "success_once", "safety", "elapsed_steps"}
+        assert info["elapsed_steps"] == t and info["safety"] == "none"
+        assert truncated == (t == env.horizon)
+        assert not terminated  # a resting arm does not push the cube
+
+
+def test_observation_is_a_fresh_array_each_step():
+    env = actionshift.make("pick_cube")
+    first, _ = env.reset(seed=2)
+    kept = first.copy()
+    env.step(np.array([1.0, 0, 0, 0, 0, 0, 1]))
+    assert np.array_equal(first, kept)
+
+
+@pytest.mark.parametrize("action,flag", [
+    ([math.nan, 0, 0, 0, 0, 0, 0], "nonfinite_action"),
+    ([0, 0, 0], "bad_action_shape"),
+    ([1e9, 0, 0, 0, 0, 0, 0], "action_out_of_range"),
+])
+def test_safety_flags_end_the_episode(action, flag):
+    env = actionshift.make("pick_cube")
+    env.reset(seed=1)
+    obs, reward, terminated, truncated, info = env.step(np.asarray(action, dtype=float))
+    assert terminated and not truncated
+    assert info["safety"] == flag
+    assert np.all(np.isfinite(obs))
+
+
+def test_hidden_contract_remaps_actions_and_is_not_observable():
+    flipped = actionshift.Contract(sign=[-1, 1, 1, 1, 1, 1])
+    plain = actionshift.make("pick_cube")
+    hidden = actionshift.make("pick_cube", contract=flipped)
+    assert not hasattr(hidden, "contract") and not hasattr(hidden._env, "contract")
+    push_x = np.array([1.0, 0, 0, 0, 0, 0, 1])
+    moves = []
+    for env in (plain, hidden):
+        obs0, _ = env.reset(seed=4)
+        obs1 = env.step(push_x)[0]
+        moves.append(env.field(obs1, "tcp_pose")[0] - env.field(obs0, "tcp_pose")[0])
+    assert moves[0] > 0.02 and moves[1] < -0.02
+
+
+def test_split_contract_by_index_matches_the_explicit_contract():
+    seen = actionshift.load_manifest("seen")
+    a = actionshift.make("pick_cube", split="seen", index=5)
+    b = actionshift.make("pick_cube", contract=seen.contracts[5])
+    raw = np.array([0.4, -0.3, 0.2, 0.1, -0.1, 0.2, -1.0])
+    a.reset(seed=9)
+    b.reset(seed=9)
+    for _ in range(3):
+        assert np.array_equal(a.step(raw)[0], b.step(raw)[0])
+
+
+def test_bad_arguments_raise_value_errors():
+    with pytest.raises(ValueError, match="task"):
+        actionshift.make("pick_banana")
+    with pytest.raises(ValueError, match="index: out of range"):
+        actionshift.make("pick_cube", split="seen", index=10_000)
+    with pytest.raises(ValueError, match="profile"):
+        actionshift.make("pick_cube", profile="no_such_profile")
+    with pytest.raises(ValueError, match="rotation"):
+        actionshift.make("pick_cube", rotation="sideways")
+    env = actionshift.make("pick_cube")
+    with pytest.raises(ValueError, match="seed"):
+        env.reset(seed=-1)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(np.zeros((2, 7)))
+
+
+def test_gymnasium_registration_when_available():
+    gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (optional; the module works without it)")
+    env = gym.make("ActionShift/PickCube-v1")
+    assert isinstance(env.unwrapped, gym.Env)
+    obs, _ = env.reset(seed=1)
+    assert obs.shape == env.observation_space.shape

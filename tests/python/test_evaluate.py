@@ -1,0 +1,67 @@
+"""evaluate(): a Python callable as the backbone, in process, writes exactly the job of the CLI's
+external-process backbone running the same policy."""
+import os
+import sys
+
+import numpy as np
+import pytest
+
+import actionshift
+
+sys.path.insert(0, os.path.dirname(__file__))
+import simple_policy  # noqa: E402
+
+COMMAND = f"{sys.executable} {os.path.abspath(simple_policy.__file__)}"
+
+
+@pytest.mark.parametrize("method,pool,episodes", [("no_adapt", None, 4), ("entropy_probes", "reference9", 3)])
+def test_in_process_job_equals_the_external_process_job(tmp_path, cli, method, pool, episodes):
+    inproc, external = tmp_path / "inproc", tmp_path / "external"
+    r = actionshift.evaluate(simple_policy.ReachGraspLift(), task="pick_cube", split="seen", method=method,
+                             pool=pool, seed=7, episodes=episodes, out=str(inproc), backbone="external:" + COMMAND)
+    assert r["episodes_run"] == episodes and r["job"]["backbone"]["name"] == "external:" + COMMAND
+    args = ["run", "--task", "pick_cube", "--split", "seen", "--method", method, "--seed", "7",
+            "--episodes", str(episodes), "--backbone", "external:" + COMMAND, "--out", str(external),
+            "--progress", "off"]
+    if pool:
+        args += ["--pool", pool]
+    out = cli(*args, check=0).stdout
+    assert out.startswith(r["job_id"] + " ")
+    a = (inproc / f"{r['job_id']}.jsonl").read_bytes()
+    b = (external / f"{r['job_id']}.jsonl").read_bytes()
+    assert a == b and a.count(b"\n") == episodes
+    # the policy does something: some episodes under no adaptation differ in return
+    again = actionshift.evaluate(simple_policy.ReachGraspLift(), task="pick_cube", split="seen", method=method,
+                                 pool=pool, seed=7, episodes=episodes, out=str(inproc), backbone="external:" + COMMAND)
+    assert again["already_complete"] and again["job_id"] == r["job_id"]
+
+
+def test_policy_identity_enters_the_job_id(tmp_path):
+    p = simple_policy.ReachGraspLift()
+    a = actionshift.evaluate(p, episodes=1, out=str(tmp_path))
+    b = actionshift.evaluate(p, episodes=1, out=str(tmp_path), backbone="python:other")
+    assert a["job"]["backbone"]["name"] == "python:simple_policy.ReachGraspLift"
+    assert a["job_id"] != b["job_id"]
+
+
+def test_evaluate_errors(tmp_path, cli):
+    with pytest.raises(ValueError) as e:
+        actionshift.evaluate(lambda obs: np.zeros(7), split="no_such_split", episodes=1, out=str(tmp_path))
+    p = cli("run", "--task", "pick_cube", "--split", "no_such_split", "--method", "no_adapt", "--episodes", "1",
+            "--out", str(tmp_path))
+    assert p.returncode == 2 and p.stderr.strip() == "actionshift: error: " + str(e.value)
+    with pytest.raises(ValueError, match="policy output: must be 7 numbers"):
+        actionshift.evaluate(lambda obs: np.zeros(3), episodes=1, out=str(tmp_path))
+
+    class Boom(Exception):
+        pass
+
+    def broken(obs):
+        raise Boom("policy failed")
+
+    with pytest.raises(Boom, match="policy failed"):
+        actionshift.evaluate(broken, episodes=1, out=str(tmp_path))
+    with pytest.raises(TypeError):
+        actionshift.evaluate("not callable", episodes=1, out=str(tmp_path))
+    with pytest.raises(ValueError, match="profile"):
+        actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), profile="no_such_profile")

@@ -1,0 +1,59 @@
+"""The self-test from Python (next_probe / observe / verdict), driving the simulator like
+`actionshift selftest --sim`, with the same verdict."""
+import json
+
+import numpy as np
+import pytest
+
+import actionshift
+
+TASK = "pick_cube"
+
+
+def pose(env, obs):
+    tcp = env.field(obs, "tcp_pose")
+    return tcp[:3], tcp[3:], env.field(obs, "qpos")[7:9]
+
+
+def run_selftest(hidden_name):
+    library = dict(actionshift.selftest_library())
+    pool = []  # the CLI's --sim pool: library then reference9, first occurrence kept
+    for c in list(library.values()) + actionshift.load_manifest("reference9").contracts:
+        if c not in pool:
+            pool.append(c)
+    st = actionshift.SelfTest(pool=pool, model=TASK, task=TASK)
+    env = actionshift.make(TASK, contract=library[hidden_name])
+    obs, _ = env.reset(seed=20260720)
+    st.begin(*pose(env, obs))
+    probes = 0
+    while (raw := st.next_probe()) is not None:
+        assert raw.shape == (7,) and raw[6] == 0.0 and np.all(np.abs(raw[:6]) <= 0.5)
+        obs, _, _, _, info = env.step(raw)
+        assert info["safety"] == "none"
+        st.observe(*pose(env, obs))
+        probes += 1
+    assert st.done and probes == st.probes_observed == 6
+    return st
+
+
+@pytest.mark.parametrize("hidden,status", [("identity", "PASS"), ("swapped-axes", "MISMATCH")])
+def test_selftest_verdict_equals_the_cli(cli, hidden, status):
+    st = run_selftest(hidden)
+    v = st.verdict()
+    assert v["status"] == status
+    assert abs(st.posterior().sum() - 1.0) < 1e-9
+    ref = json.loads(cli("selftest", "--sim", "--task", TASK, "--hidden-contract", hidden, "--json").stdout)
+    assert ref["status"] == status
+    for key in ("identified_contract", "diff_fields", "field_diffs", "probe_steps", "field_confidence", "fit_ratio"):
+        assert v[key] == ref[key], key
+    assert status in st.report()
+
+
+def test_selftest_misuse_raises():
+    with pytest.raises(ValueError, match="budget"):
+        actionshift.SelfTest(budget=0)
+    st = actionshift.SelfTest()
+    with pytest.raises(RuntimeError):
+        st.next_probe()  # begin() was not called (std::logic_error)
+    with pytest.raises(ValueError):
+        st.begin([0, 0, 0], [0, 0, 0, 0])  # zero quaternion
