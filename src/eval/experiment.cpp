@@ -129,7 +129,7 @@ struct Context {
     adapter->begin_episode(t.adapter_seed);  // never the environment's seed: it names the contract
     EpisodeRecord rec;
     rec.contract_sha256 = truth.sha256();
-    const sim::OracleRecorder view(env);
+    const sim::OracleRecorder view = detail::OracleAccess::view(env);
     auto show = [&](int step, bool probe) {
       if (hooks.observer) hooks.observer(EpisodeStepView{step, env.horizon(), probe, &env.last(), &view.env()});
     };
