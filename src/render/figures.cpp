@@ -275,7 +275,8 @@ std::vector<Figure> pareto_figures(const std::vector<eval::CellSummary>& cells) 
   for (const auto& [task, cs] : by_task) {
     std::set<std::string> methods;
     for (const auto* c : cs) methods.insert(c->key.method);
-    if (methods.size() < 2) continue;
+    const bool probes = std::any_of(cs.begin(), cs.end(), [](const auto* c) { return c->mean_probe_steps > 0.0; });
+    if (methods.size() < 2 || !probes) continue;  // a probe-cost plot needs a method that probes
     double xmax = 1.0;
     for (const auto* c : cs) xmax = std::max(xmax, c->mean_probe_steps);
     xmax = std::ceil(xmax * 1.1);

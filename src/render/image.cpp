@@ -3,8 +3,10 @@
 
 #include "actionshift/core/error.hpp"
 
+#include <fcntl.h>
 #include <gif_lib.h>
 #include <png.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -171,9 +173,15 @@ void write_gif(const std::filesystem::path& path, const std::vector<Image>& fram
   const int w = frames.front().width(), h = frames.front().height();
   for (const Image& f : frames)
     if (f.width() != w || f.height() != h) throw std::invalid_argument("write_gif: frames of different sizes");
+  // open the file ourselves: giflib's EGifOpenFileName creates it with mode 0600
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
+  if (fd < 0) throw InputError(path.string(), "out", "cannot write file");
   int err = 0;
-  GifFileType* gif = EGifOpenFileName(path.c_str(), false, &err);
-  if (!gif) throw InputError(path.string(), "out", std::string("cannot write file (") + GifErrorString(err) + ")");
+  GifFileType* gif = EGifOpenFileHandle(fd, &err);
+  if (!gif) {
+    ::close(fd);
+    throw InputError(path.string(), "out", std::string("cannot write file (") + GifErrorString(err) + ")");
+  }
   auto fail = [&](const char* what) {
     int close_err = 0;
     EGifCloseFile(gif, &close_err);

@@ -73,9 +73,9 @@ TEST(Figures, Gate1BarsHaveHeightsOfTheRatesAndWilsonWhiskers) {
   EXPECT_THAT(fig->svg, HasSubstr(">fail</text>"));
   EXPECT_EQ(count(fig->svg, "stroke=\"#111\""), 2 * 3);  // whisker + two caps per bar
 
-  // no ladder / Pareto without methods beyond the Gate 1 pair... the Pareto figure needs two methods
+  // no ladder without a method beyond the Gate 1 pair, no Pareto plot without a method that probes
   EXPECT_TRUE(ladder_figures(cells).empty());
-  EXPECT_EQ(pareto_figures(cells).size(), 1u);
+  EXPECT_TRUE(pareto_figures(cells).empty());
   EXPECT_FALSE(long_lag_figure(cells).has_value());
   // a figure whose inputs are absent is skipped
   const auto only_oracle = eval::summarize_records(cell("pick_cube", "seen", "oracle", 4, 4, 0));
@@ -135,7 +135,7 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
   const ReportResult r = write_report((root / "results").string(), (root / "out").string());
   EXPECT_EQ(r.summaries, 1u);
   EXPECT_EQ(r.verdicts, 1u);
-  ASSERT_EQ(r.figures.size(), 2u);  // gate1 and Pareto
+  ASSERT_EQ(r.figures.size(), 1u);  // Gate 1 (no ladder, and no Pareto plot: nothing probes)
   std::ifstream f(r.html_path);
   std::stringstream ss;
   ss << f.rdbuf();
@@ -154,7 +154,7 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
     else
       EXPECT_TRUE(fs::exists(root / "out" / t)) << t;
   }
-  EXPECT_GE(targets, 6);  // summary.json, verdict copy, 2 figures x (img + link), 1 job anchor
+  EXPECT_GE(targets, 5);  // summary.json, verdict copy, the figure's img and link, 1 job anchor
   EXPECT_TRUE(fs::exists(r.markdown_path));
   EXPECT_THAT([&] { write_report((root / "missing").string(), (root / "out").string()); },
               ::testing::ThrowsMessage<InputError>(HasSubstr("not a directory")));

@@ -163,7 +163,8 @@ TEST(Images, GifRoundTripsFramesAndPngIsWritten) {
     EXPECT_NEAR(bg.b, 60, 8);
   }
   EXPECT_FALSE(reddish(back[0].at(30, 15)));  // the square moved
-  EXPECT_EQ(back[0].at(2, 1), (Rgb{255, 255, 255}));  // the 's' of the overlay text
+  const Rgb s = back[0].at(2, 1);  // the 's' of the overlay text; giflib quantises to 5 bits a channel
+  EXPECT_TRUE(s.r >= 240 && s.g >= 240 && s.b >= 240) << int(s.r) << "," << int(s.g) << "," << int(s.b);
 
   const fs::path png = temp_file("frame.png");
   write_png(png, frames[0]);

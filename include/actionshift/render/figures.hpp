@@ -35,7 +35,7 @@ std::vector<Figure> ladder_figures(const std::vector<eval::CellSummary>& cells);
 
 /// Probe cost against success: per task, one point per (split, method) at (mean probe steps,
 /// success_once) with its Wilson interval, and the Pareto front (no point has both fewer probe
-/// steps and higher success). One figure per task with at least two methods.
+/// steps and higher success). One figure per task with at least two methods, one of which probes.
 std::vector<Figure> pareto_figures(const std::vector<eval::CellSummary>& cells);
 
 /// Long lag: per task, one bar per method on the splits whose name contains "long_lag". Empty when
