@@ -60,7 +60,7 @@ TEST(Verdict, UnconfidentDiffAbstainsRatherThanGuessing) {
 
 // printed numbers never contradict the comparison they report
 TEST(Verdict, PrintedComparisonsNeverContradictThemselves) {
-  Evidence e = confident(Contract::identity(), kMiswired);
+  Evidence e = confident(Contract::identity(), Contract::identity());
   e.confidence[static_cast<std::size_t>(Field::kPermutation)] = 0.8996;
   Verdict v = decide_verdict(e, 0.9, 4.0);
   EXPECT_EQ(v.status, Status::kInconclusive);
