@@ -4,6 +4,7 @@
 
 #include "actionshift/adapt/calibration.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
@@ -13,11 +14,23 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
 #include <sstream>
+#include <vector>
+
+namespace actionshift::embedded {
+extern const std::string_view selftest_sim_misspec;  // configs/selftest/sim_misspec.json
+}
 
 namespace actionshift::cli {
 
@@ -29,34 +42,6 @@ std::string read_text(const std::string& path) {
   s << in.rdbuf();
   if (!in && !in.eof()) throw InputError(path, "", "cannot read file");
   return s.str();
-}
-
-// a contract argument: library name, MANIFEST:INDEX, file with contract JSON, or inline JSON
-Contract resolve_contract(const std::string& arg, const std::string& option) {
-  if (auto c = selftest::named_contract(arg)) return *c;
-  if (const auto colon = arg.rfind(':'); colon != std::string::npos && colon + 1 < arg.size() &&
-                                         arg.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
-                                         arg.find('{') == std::string::npos) {
-    const Manifest m = data::resolve_manifest(arg.substr(0, colon));
-    const auto cs = m.contracts();
-    const std::size_t i = std::stoul(arg.substr(colon + 1));
-    if (i >= cs.size())
-      throw InputError("", option, "'" + arg + "': index out of range (the manifest has " + std::to_string(cs.size()) +
-                                       " contracts)");
-    return cs[i];
-  }
-  std::error_code ec;
-  const bool is_file = arg.find('{') == std::string::npos && std::filesystem::is_regular_file(arg, ec);
-  const std::string text = is_file ? read_text(arg) : arg;
-  if (!is_file && arg.find('{') == std::string::npos)
-    throw InputError("", option,
-                     "'" + arg + "' is not a library name (" + selftest::named_contract_list() +
-                         "), MANIFEST:INDEX, a contract file or contract JSON");
-  try {
-    return Contract::from_json(text);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(is_file ? arg : "", option, e.what());
-  }
 }
 
 std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
@@ -93,14 +78,11 @@ selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::Observati
 
 // drives the self-test against the Bullet environment under the hidden contract; returns a note if
 // the episode ended early
-std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o) {
-  const sim::TaskId task = sim::parse_task(o.task);
-  std::shared_ptr<const sim::RobotDescription> robot;
-  if (!o.robot.urdf.empty()) robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
-  auto model = sim::EnvModel::make(task, sim::profile_config(o.profile), robot);
+std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o,
+                    const std::shared_ptr<const sim::EnvModel>& model, std::uint64_t seed) {
   sim::HiddenContractEnv env(model, hidden,
                              o.frame_rotation == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp);
-  st.begin(pose_from_obs(env.reset(o.seed), env.layout()));
+  st.begin(pose_from_obs(env.reset(seed), env.layout()));
   while (auto raw = st.next_probe()) {
     const sim::StepResult& r = env.step(*raw);
     if (r.safety != sim::SafetyFlag::kNone)
@@ -111,6 +93,88 @@ std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const Selfte
       return "the episode reached the task horizon after " + std::to_string(st.probes_observed()) + " probes";
   }
   return {};
+}
+
+// `--sim --calibrate-misspec FILE`: the misspecification thresholds from the simulator's own
+// residuals. Every member of the declared pool is the hidden wiring in turn (so the true wiring is
+// in the pool), over kMisspecCalibrationSeeds initial states; the fit ratios of the runs that
+// identified the true wiring are the residuals of a correct hypothesis on this simulator. They are
+// split by the target type of the wiring (the calibrated gain describes delta commands, so absolute
+// wirings fit on another scale), and each threshold is that class's largest fit ratio times
+// kMisspecCalibrationMargin. The task's entry of FILE is (re)written.
+// the --sim environment: the task on the chosen fidelity profile and robot description
+std::shared_ptr<const sim::EnvModel> sim_model(const SelftestOptions& o) {
+  std::shared_ptr<const sim::RobotDescription> robot;
+  if (!o.robot.urdf.empty()) robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
+  return sim::EnvModel::make(sim::parse_task(o.task), sim::profile_config(o.profile), robot);
+}
+
+int calibrate_misspec(const SelftestOptions& o, const selftest::Options& base, const adapt::ResponseCalibration& cal) {
+  const sim::TaskId task = sim::parse_task(o.task);
+  const auto model = sim_model(o);
+  std::map<std::string, std::vector<double>> fits;  // by target type of the true wiring
+  int misidentified = 0, cut_short = 0;
+  for (const Contract& hidden : base.pool) {
+    for (int k = 0; k < kMisspecCalibrationSeeds; ++k) {
+      selftest::SelfTest st(base);
+      if (!run_sim(st, hidden, o, model, o.seed + static_cast<std::uint64_t>(k)).empty()) {
+        ++cut_short;
+        continue;
+      }
+      const selftest::Evidence e = st.evidence();
+      if (e.identified == hidden) fits[hidden.target() == Target::kAbsolute ? "absolute" : "delta"].push_back(e.fit_ratio);
+      else ++misidentified;
+    }
+  }
+  if (fits["delta"].empty())
+    throw InputError(o.task, "--calibrate-misspec", "no delta wiring of the pool was identified: nothing to calibrate on");
+  nlohmann::json entry = {{"margin", kMisspecCalibrationMargin},
+                          {"runs_misidentified", misidentified},
+                          {"runs_cut_short", cut_short},
+                          {"pool_size", base.pool.size()},
+                          {"seeds", {{"first", o.seed}, {"count", kMisspecCalibrationSeeds}}},
+                          {"budget", base.budget},
+                          {"amplitude", base.amplitude},
+                          {"strategy", o.strategy},
+                          {"frame_rotation", o.frame_rotation},
+                          {"calibration_sha256", cal.sha256()}};
+  std::string summary;
+  for (auto& [cls, v] : fits) {
+    if (v.empty()) continue;
+    std::sort(v.begin(), v.end());
+    const double threshold = v.back() * kMisspecCalibrationMargin;
+    entry[cls] = {{"misspec_ratio", threshold},
+                  {"max_fit_ratio", v.back()},
+                  {"median_fit_ratio", v[v.size() / 2]},
+                  {"runs_identified", v.size()}};
+    char line[160];
+    std::snprintf(line, sizeof line, "%s%s %.4g (max fit %.4g x %.2g over %zu runs)", summary.empty() ? "" : ", ", cls.c_str(),
+                  threshold, v.back(), kMisspecCalibrationMargin, v.size());
+    summary += line;
+  }
+  nlohmann::json all = nlohmann::json::object();
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(o.calibrate_misspec, ec)) all = parse_json_input(read_text(o.calibrate_misspec), o.calibrate_misspec);
+  if (!all.is_object()) throw InputError(o.calibrate_misspec, "", "expected a JSON object of tasks");
+  all[o.task] = entry;
+  const std::string tmp = o.calibrate_misspec + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << all.dump(2) << "\n";
+    f.flush();
+    if (!f) {
+      std::filesystem::remove(tmp, ec);
+      throw InputError(o.calibrate_misspec, "--calibrate-misspec", "cannot write the file");
+    }
+  }
+  std::filesystem::rename(tmp, o.calibrate_misspec, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(o.calibrate_misspec, "--calibrate-misspec", "cannot rename the temporary file into place");
+  }
+  std::cout << "misspecification thresholds for " << o.task << ": " << summary << "; " << misidentified
+            << " runs misidentified, " << cut_short << " cut short; written to " << o.calibrate_misspec << "\n";
+  return 0;
 }
 
 int run(const SelftestOptions& o) {
@@ -128,7 +192,7 @@ int run(const SelftestOptions& o) {
   if (o.robot.urdf.empty() && !o.robot.packages.empty()) throw InputError("", "--package", "needs --robot URDF");
 
   selftest::Options so;
-  so.expected = resolve_contract(o.expected, "--expected");
+  so.expected = resolve_contract_arg(o.expected, "--expected");
   Contract hidden = so.expected;
   if (!o.demo.empty()) {
     bool found = false;
@@ -142,7 +206,7 @@ int run(const SelftestOptions& o) {
                        "unknown demo '" + o.demo +
                            "' (identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled)");
   } else if (!o.hidden_contract.empty()) {
-    hidden = resolve_contract(o.hidden_contract, "--hidden-contract");
+    hidden = resolve_contract_arg(o.hidden_contract, "--hidden-contract");
   }
   std::vector<std::string> pool_names = o.pools;
   if (pool_names.empty()) pool_names = o.sim ? std::vector<std::string>{"library", "reference9"} : std::vector<std::string>{"library"};
@@ -151,7 +215,20 @@ int run(const SelftestOptions& o) {
   so.budget = o.budget.value_or(o.sim ? kSimDefaultBudget : 6);
   so.amplitude = o.amplitude.value_or(o.sim ? kSimDefaultAmplitude : 0.5);
   so.confidence_floor = o.confidence_floor;
-  so.misspec_ratio = o.misspec_ratio;
+  if (!o.sim && !o.calibrate_misspec.empty()) throw InputError("", "--calibrate-misspec", "only applies with --sim");
+  std::string misspec_source = o.misspec_ratio ? "--misspec-ratio" : "default";
+  if (o.misspec_ratio) {
+    so.misspec_ratio = *o.misspec_ratio;
+  } else if (!o.sim) {
+    so.misspec_ratio = kSyntheticMisspecRatio;
+  } else if (const auto calibrated = calibrated_sim_misspec_ratio(o.task, "delta")) {
+    so.misspec_ratio = *calibrated;
+    so.misspec_ratio_absolute = calibrated_sim_misspec_ratio(o.task, "absolute");
+    misspec_source = "calibrated on the simulator's residuals";
+  } else {
+    so.misspec_ratio = kUncalibratedSimMisspecRatio;
+    misspec_source = "uncalibrated default";
+  }
 
   selftest::ReportHeader h;
   h.task = o.task;
@@ -167,11 +244,18 @@ int run(const SelftestOptions& o) {
     const auto cal = load_calibration(o);
     so.model = cal.model();
     so.frame_rotation = o.frame_rotation == "identity" ? selftest::FrameRotation::kIdentity : selftest::FrameRotation::kMeasured;
-    h.backend = "Bullet simulator, calibration " + cal.sha256().substr(0, 12) + ", frame rotation " + o.frame_rotation;
+    char ratio[96];
+    if (so.misspec_ratio_absolute)
+      std::snprintf(ratio, sizeof ratio, "%.3g (delta wirings), %.3g (absolute)", so.misspec_ratio, *so.misspec_ratio_absolute);
+    else
+      std::snprintf(ratio, sizeof ratio, "%.3g", so.misspec_ratio);
+    h.backend = "Bullet simulator, calibration " + cal.sha256().substr(0, 12) + ", frame rotation " + o.frame_rotation +
+                ", misspecification threshold " + ratio + " x noise (" + misspec_source + ")";
     h.unit = "m";
     st = selftest::SelfTest::create(so, &err);
     if (!st) throw InputError("", "selftest", err);
-    note = run_sim(*st, hidden, o);
+    if (!o.calibrate_misspec.empty()) return calibrate_misspec(o, st->options(), cal);
+    note = run_sim(*st, hidden, o, sim_model(o), o.seed);
   } else {
     so.frame_rotation = selftest::FrameRotation::kIdentity;  // the stand-in decodes with R = I (docs/reference.md, *Self-test*)
     h.backend = "synthetic stand-in: alpha 1, sigma 0.05, R = I";
@@ -196,6 +280,51 @@ int run(const SelftestOptions& o) {
 }
 
 }  // namespace
+
+// a contract argument: library name, MANIFEST:INDEX, file with contract JSON, or inline JSON
+Contract resolve_contract_arg(const std::string& arg, const std::string& option) {
+  if (auto c = selftest::named_contract(arg)) return *c;
+  if (const auto colon = arg.rfind(':'); colon != std::string::npos && colon + 1 < arg.size() &&
+                                         arg.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
+                                         arg.find('{') == std::string::npos) {
+    const Manifest m = data::resolve_manifest(arg.substr(0, colon));
+    const auto cs = m.contracts();
+    std::size_t i = 0;
+    const std::string digits = arg.substr(colon + 1);
+    const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), i);
+    if (parsed.ec != std::errc() || i >= cs.size())
+      throw InputError("", option, "'" + arg + "': index out of range (the manifest has " + std::to_string(cs.size()) +
+                                       " contracts)");
+    return cs[i];
+  }
+  std::error_code ec;
+  const bool is_file = arg.find('{') == std::string::npos && std::filesystem::is_regular_file(arg, ec);
+  const std::string text = is_file ? read_text(arg) : arg;
+  if (!is_file && arg.find('{') == std::string::npos)
+    throw InputError("", option,
+                     "'" + arg + "' is not a library name (" + selftest::named_contract_list() +
+                         "), MANIFEST:INDEX, a contract file or contract JSON");
+  try {
+    return Contract::from_json(text);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(is_file ? arg : "", option, e.what());
+  }
+}
+
+
+std::optional<double> calibrated_sim_misspec_ratio(const std::string& task, const std::string& target_class) {
+  const std::string src = "configs/selftest/sim_misspec.json";
+  const nlohmann::json all = parse_json_input(embedded::selftest_sim_misspec, src);
+  if (!all.is_object() || !all.contains(task) || !all.at(task).is_object() || !all.at(task).contains(target_class))
+    return std::nullopt;
+  const std::string field = task + "." + target_class + ".misspec_ratio";
+  const nlohmann::json& entry = all.at(task).at(target_class);
+  if (!entry.is_object() || !entry.contains("misspec_ratio") || !entry.at("misspec_ratio").is_number())
+    throw InputError(src, field, "missing or not a number");
+  const double r = entry.at("misspec_ratio").get<double>();
+  if (!(r > 0.0) || !std::isfinite(r)) throw InputError(src, field, "must be finite and positive");
+  return r;
+}
 
 int run_selftest(const SelftestOptions& o) {
   try {

@@ -4,6 +4,7 @@
 // catches its own errors so that bad input is 3, not the CLI's generic 2.
 
 #include "commands.hpp"
+#include "actionshift/core/contract.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -32,11 +33,30 @@ struct SelftestOptions {
   std::optional<int> budget;                 ///< default 6 (synthetic), kSimDefaultBudget (sim)
   std::optional<double> amplitude;           ///< default 0.5 (synthetic), kSimDefaultAmplitude (sim)
   double confidence_floor = 0.9;
-  double misspec_ratio = 4.0;
+  std::optional<double> misspec_ratio;      ///< default 4.0 (synthetic); --sim: the task's calibrated value
+  std::string calibrate_misspec;             ///< --sim: measure the misspecification threshold, write it here
   std::uint64_t seed = 20260720;
   bool json = false;
   RobotOptions robot;                        ///< --sim: --robot/--package
 };
+
+/// A contract argument (--expected, --hidden-contract): a library name, MANIFEST:INDEX, a file with
+/// contract JSON, or inline contract JSON. throws actionshift::InputError naming `option` and the
+/// file (if any) for anything else. Public for the CLI tests and the fuzzer.
+Contract resolve_contract_arg(const std::string& arg, const std::string& option);
+
+/// Default --misspec-ratio of the synthetic stand-in (its noise model is exact).
+inline constexpr double kSyntheticMisspecRatio = 4.0;
+/// Default --misspec-ratio of --sim for a task without a calibrated value in configs/selftest/sim_misspec.json.
+inline constexpr double kUncalibratedSimMisspecRatio = 4.0;
+/// Seeds per in-pool wiring and safety margin of `selftest --sim --calibrate-misspec`.
+inline constexpr int kMisspecCalibrationSeeds = 8;
+inline constexpr double kMisspecCalibrationMargin = 1.5;
+
+/// The calibrated --sim misspecification threshold of `task` for MAP wirings of `target_class`
+/// ("delta" or "absolute") from the embedded configs/selftest/sim_misspec.json, or nullopt if the
+/// task has none. Throws InputError for a malformed entry.
+std::optional<double> calibrated_sim_misspec_ratio(const std::string& task, const std::string& target_class);
 
 /// Runs the self-test and prints the report (text or JSON) on stdout. Returns 0/1/2 by verdict, 3 for
 /// bad input (one "actionshift: error: ..." line on stderr).

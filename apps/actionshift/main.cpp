@@ -122,8 +122,13 @@ int main(int argc, char** argv) {
   st->add_option("--amplitude", st_o.amplitude, "Probe bound per pose channel, in (0, 1] (default 0.5)");
   st->add_option("--confidence-floor", st_o.confidence_floor, "Per-field confidence needed to resolve a field")
       ->capture_default_str();
-  st->add_option("--misspec-ratio", st_o.misspec_ratio, "Abstain when the best fit exceeds this many times the noise")
-      ->capture_default_str();
+  st->add_option("--misspec-ratio", st_o.misspec_ratio,
+                 "Abstain when the best fit exceeds this many times the noise (default 4; with --sim the task's value\n"
+                 "calibrated on the simulator's own residuals, configs/selftest/sim_misspec.json)");
+  st->add_option("--calibrate-misspec", st_o.calibrate_misspec,
+                 "--sim: measure the misspecification threshold on the simulator (every pool member as the hidden\n"
+                 "wiring, 8 seeds from --seed; max fit ratio of the correctly identified runs x 1.5) and write the\n"
+                 "task's entry of this JSON file (configs/selftest/sim_misspec.json, embedded at build time)");
   st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
   st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
   add_robot_options(st, st_o.robot);
@@ -216,6 +221,11 @@ int main(int argc, char** argv) {
   run->add_option("--policy-files", run_o.policy_files,
                   "Files of an external:<command> backbone (script, weights, config): their content hash enters the\n"
                   "job id, so editing the policy makes a new job instead of reusing old results");
+  run->add_option("--step-timeout", run_o.run.step_timeout_s,
+                  "Seconds an external:<command> backbone may take to read one request and to reply to it\n"
+                  "(a process that overruns, floods replies or dies ends the job with an error)")
+      ->check(CLI::Range(0.001, 86400.0))
+      ->capture_default_str();
   run->callback([&] {
     action = [&] {
       if (run_job_index >= 0) run_o.run.job_index = run_job_index;

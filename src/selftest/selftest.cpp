@@ -73,6 +73,8 @@ bool validate(const Options& o, std::string* err) noexcept {
     return fail(err, "confidence_floor must be in (0, 1] (got " + num(o.confidence_floor) + ")");
   if (!(o.misspec_ratio > 0.0) || !std::isfinite(o.misspec_ratio))
     return fail(err, "misspec_ratio must be finite and positive (got " + num(o.misspec_ratio) + ")");
+  if (o.misspec_ratio_absolute && (!(*o.misspec_ratio_absolute > 0.0) || !std::isfinite(*o.misspec_ratio_absolute)))
+    return fail(err, "misspec_ratio_absolute must be finite and positive (got " + num(*o.misspec_ratio_absolute) + ")");
   if (!(o.min_frame_angle >= 0.0) || !std::isfinite(o.min_frame_angle))
     return fail(err, "min_frame_angle must be finite and nonnegative (got " + num(o.min_frame_angle) + ")");
   if (o.strategy != Strategy::kFixed && o.strategy != Strategy::kEntropy) return fail(err, "strategy must be fixed or entropy");
@@ -314,7 +316,11 @@ Evidence SelfTest::evidence() const {
 
 Verdict SelfTest::verdict() const {
   const auto& s = *impl_;
-  Verdict v = decide_verdict(evidence(), s.opt.confidence_floor, s.opt.misspec_ratio);
+  const Evidence e = evidence();
+  const double ratio = e.identified.target() == Target::kAbsolute && s.opt.misspec_ratio_absolute
+                           ? *s.opt.misspec_ratio_absolute
+                           : s.opt.misspec_ratio;
+  Verdict v = decide_verdict(e, s.opt.confidence_floor, ratio);
   v.probe_steps = static_cast<int>(s.raws.size());
   v.amplitude = s.opt.amplitude;
   v.displacement = s.path;

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <string_view>
+#include <utility>
 
 namespace actionshift::selftest {
 
@@ -47,6 +49,19 @@ std::string fmt(const char* f, double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, x);
   return buf;
+}
+
+// `a` and `b` printed with the fewest decimals (at least `min_decimals`, at most 9) that keep them
+// apart, so a printed comparison never contradicts itself ("0.90 < floor 0.90" becomes
+// "0.8996 < floor 0.9000"); equal values print with `min_decimals`.
+std::pair<std::string, std::string> distinct(double a, double b, int min_decimals) {
+  char fa[64], fb[64];
+  for (int d = min_decimals; d <= 9; ++d) {
+    std::snprintf(fa, sizeof fa, "%.*f", d, a);
+    std::snprintf(fb, sizeof fb, "%.*f", d, b);
+    if (a == b || std::string_view(fa) != std::string_view(fb)) break;
+  }
+  return {fa, fb};
 }
 
 template <class T>
@@ -165,8 +180,9 @@ Verdict decide_verdict(const Evidence& e, double floor, double ratio) {
   if (e.fit_ratio > ratio) {
     v.status = Status::kInconclusive;
     for (Field f : checked) v.unresolved_fields.emplace_back(to_string(f));
-    v.reason = "response misspecification: the best hypothesis fits the probe responses at " + fmt("%.1f", e.fit_ratio) +
-               "x the calibrated noise scale (threshold " + fmt("%.1f", ratio) +
+    const auto [fit, threshold] = distinct(e.fit_ratio, ratio, 1);
+    v.reason = "response misspecification: the best hypothesis fits the probe responses at " + fit +
+               "x the calibrated noise scale (threshold " + threshold +
                "x) -- the true wiring is likely outside the declared pool. Abstaining.";
     return v;
   }
@@ -193,8 +209,9 @@ Verdict decide_verdict(const Evidence& e, double floor, double ratio) {
                   " were not resolved and are not part of this verdict)";
   } else if (!v.unresolved_fields.empty()) {
     v.status = Status::kInconclusive;
-    v.reason = "insufficient posterior mass to resolve field(s) " + quoted_list(v.unresolved_fields) + " (weakest " +
-               fmt("%.2f", weakest) + " < floor " + fmt("%.2f", floor) + "). Abstaining rather than guessing.";
+    const auto [low, bar] = distinct(weakest, floor, 2);
+    v.reason = "insufficient posterior mass to resolve field(s) " + quoted_list(v.unresolved_fields) + " (weakest " + low +
+               " < floor " + bar + "). Abstaining rather than guessing.";
   } else {
     v.status = Status::kPass;
     v.reason = "every observable field resolved with high confidence and matches the expected wiring";
@@ -223,9 +240,12 @@ std::string to_text(const Verdict& v, const ReportHeader& h) {
     o << line;
   }
   o << "  gripper_inverted not checked (out of scope for a pose probe)\n";
-  std::snprintf(line, sizeof line, "  fit residual: %.2fx calibrated noise scale (%s)\n", v.evidence.fit_ratio,
-                v.evidence.fit_ratio > v.misspec_ratio ? "TOO LARGE" : "ok");
-  o << line << "\nCannot be checked in this run:\n";
+  {
+    const auto [fit, threshold] = distinct(v.evidence.fit_ratio, v.misspec_ratio, 2);
+    o << "  fit residual: " << fit << "x calibrated noise scale ("
+      << (v.evidence.fit_ratio > v.misspec_ratio ? "TOO LARGE, > " : "ok, <= ") << threshold << "x)\n";
+  }
+  o << "\nCannot be checked in this run:\n";
   for (const auto& u : v.unchecked) o << "  " << u.field << ": " << u.reason << "\n";
   o << "\nVERDICT: " << to_string(v.status) << "  (exit " << v.exit_code() << ")\n  " << v.reason << "\n";
   return o.str();

@@ -154,14 +154,22 @@ int xml_depth(std::string_view xml) {
 // process-global, hence the mutex around every parse.
 class CapturingHandler final : public console_bridge::OutputHandler {
  public:
+  // urdfdom reports the specific cause first ("Joint [j] is of type REVOLUTE but it does not
+  // specify limits") and a generic one last ("joint xml is not initialized correctly"): keep both
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
     if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN && first_.empty()) first_ = text;
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) last_error_ = text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      if (first_error_.empty()) first_error_ = text;
+      last_error_ = text;
+    }
   }
-  std::string reason() const { return last_error_.empty() ? first_ : last_error_; }
+  std::string reason() const {
+    if (first_error_.empty()) return first_;
+    return last_error_ == first_error_ ? first_error_ : first_error_ + "; " + last_error_;
+  }
 
  private:
-  std::string first_, last_error_;
+  std::string first_, first_error_, last_error_;
 };
 
 urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::string_view origin) {

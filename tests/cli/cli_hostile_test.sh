@@ -46,15 +46,16 @@ lines = open(src).read().splitlines()
 first = lines[0]
 open(deep, 'w').write(first[:-1] + ',"x":' + '[' * 100000 + ']' * 100000 + '}\n')
 import re
-open(ovf, 'w').write(re.sub(r'"task_return":[^,}]+', '"task_return":1e999', first) + '\n')
+open(ovf, 'w').write(re.sub(r'"return":[^,}]+', '"return":1e999', first) + '\n')
 PY
-run "$AS" summarize --results "$TMP/deep"
+run "$AS" summarize "$TMP/deep"
 expect_rc 2 "deep record"
 expect_one_line_error "deep record"
-run "$AS" summarize --results "$TMP/ovf"
+expect_err "nested deeper than" "deep record"
+run "$AS" summarize "$TMP/ovf"
 expect_rc 2 "overflowing record"
 expect_one_line_error "overflowing record"
-expect_err "task_return" "overflowing record names the field"
+expect_err ": return: number out of range" "overflowing record names the field"
 expect_err "out of range" "overflowing record says why"
 # a resume repairs a last record that ends in 1e999 (a torn write), with nothing else lost
 python3 - "$JL" <<'PY'
@@ -70,7 +71,7 @@ expect_err "repaired a torn last line" "resume logs the repair"
 cmp -s "$JL" "$TMP/clean.jsonl" && ok || bad "the repaired JSONL differs from the clean run"
 
 # ---- run --split FILE verifies the stored hashes; the clean copy still runs
-sed 's/"scale": \[1.0/"scale": [0.5/' "$SRC/manifests/reference_seen.json" > "$TMP/tampered.json"
+sed 's/"scale":\[0.5,/"scale":[0.25,/' "$SRC/manifests/reference_seen.json" > "$TMP/tampered.json"
 cmp -s "$TMP/tampered.json" "$SRC/manifests/reference_seen.json" && bad "tamper did not change the file" || ok
 run "$AS" run --task pick_cube --split "$TMP/tampered.json" --method oracle --episodes 1 --out "$TMP/tam" --progress off
 expect_rc 2 "tampered split"
@@ -106,7 +107,7 @@ expect_rc 2 "deep YAML"
 expect_one_line_error "deep YAML"
 
 # ---- selftest contract arguments: bad input is exit 3, one line
-run "$AS" selftest --expected "$(deep 100000)"
+run "$AS" selftest --expected "{\"a\":$(deep 50000)}"
 expect_rc 3 "selftest deep contract"
 expect_one_line_error "selftest deep contract"
 run "$AS" selftest --expected "reference_seen:99999999999999999999999"
@@ -125,11 +126,11 @@ for line in sys.stdin:
         sys.stdout.flush()
 PY
 start=$(date +%s)
-run timeout 60 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --threads 1 \
+run timeout 120 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --threads 1 \
   --backbone "external:python3 $TMP/flood.py" --step-timeout 5 --out "$TMP/flood" --progress off
 expect_rc 2 "flooding policy"
 expect_err "protocol error" "flooding policy"
-[ $(( $(date +%s) - start )) -lt 30 ] && ok || bad "flooding policy took too long"
+[ $(( $(date +%s) - start )) -lt 100 ] && ok || bad "flooding policy took too long"
 cat > "$TMP/mute.py" <<'PY'
 import sys, time
 sys.stdin.readline()

@@ -112,4 +112,33 @@ sim_fields reference_unseen_composition:1 permutation,sign,target gripper_invert
 run "$BIN" selftest --sim --task pick_cube --frame-rotation identity --hidden-contract reference_seen:0
 expect_out "frame: tool frame under identity rotation" "sim, identity rotation: frame unchecked"
 
+# ---- misspecification on the simulator (thresholds calibrated on its own residuals, committed in
+# configs/selftest/sim_misspec.json): the unmodeled wiring and wirings outside the declared pool
+# abstain, on every cube task and seed tried; identity still passes with the same pool
+for task in pick_cube push_cube pull_cube stack_cube; do
+  seeds="20260720"
+  [ "$task" = pick_cube ] && seeds="20260720 1 2"
+  for seed in $seeds; do
+    for hidden in unmodeled reference_seen:0 reference_seen:1 reference_unseen_composition:0 reference_unseen_composition:1; do
+      run "$BIN" selftest --sim --task "$task" --hidden-contract "$hidden" --pool library --seed "$seed"
+      expect_rc 2 "sim $task $hidden (outside the library pool) seed $seed abstains"
+      expect_out "response misspecification" "sim $task $hidden seed $seed: the reason is the misspecification"
+    done
+    run "$BIN" selftest --sim --task "$task" --pool library --seed "$seed"
+    expect_rc 0 "sim $task identity with the library pool, seed $seed"
+  done
+done
+run "$BIN" selftest --sim --task pick_cube --hidden-contract unmodeled --pool library
+expect_out "calibrated on the simulator's residuals" "the report says where the threshold comes from"
+expect_out "(TOO LARGE, > " "the fit line agrees with the verdict"
+# the calibration procedure itself (what produced the committed file) and its bad input
+run "$BIN" selftest --sim --task pick_cube --calibrate-misspec "$TMP/misspec.json"
+expect_rc 0 "calibrate-misspec"
+python3 - "$TMP/misspec.json" <<'PY' && ok || bad "calibrate-misspec writes a positive delta threshold above every correct fit"
+import json, sys
+e = json.load(open(sys.argv[1]))["pick_cube"]
+assert e["delta"]["misspec_ratio"] > e["delta"]["max_fit_ratio"] > 0 and e["runs_misidentified"] == 0
+PY
+bad_input "calibrate-misspec without --sim" --calibrate-misspec "$TMP/x.json"
+
 finish

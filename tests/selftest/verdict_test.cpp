@@ -58,6 +58,23 @@ TEST(Verdict, UnconfidentDiffAbstainsRatherThanGuessing) {
   EXPECT_TRUE(v.field_diffs.empty());
 }
 
+// printed numbers never contradict the comparison they report
+TEST(Verdict, PrintedComparisonsNeverContradictThemselves) {
+  Evidence e = confident(Contract::identity(), Contract::identity());
+  e.confidence[static_cast<std::size_t>(Field::kPermutation)] = 0.8996;
+  Verdict v = decide_verdict(e, 0.9, 4.0);
+  EXPECT_EQ(v.status, Status::kInconclusive);
+  EXPECT_THAT(v.reason, HasSubstr("(weakest 0.8996 < floor 0.9000)"));
+  e = confident(Contract::identity(), Contract::identity());
+  e.fit_ratio = 4.04;
+  v = decide_verdict(e, 0.9, 4.0);
+  EXPECT_EQ(v.status, Status::kInconclusive);
+  EXPECT_THAT(v.reason, HasSubstr("at 4.04x the calibrated noise scale (threshold 4.00x)"));
+  EXPECT_THAT(to_text(v, {}), HasSubstr("fit residual: 4.04x calibrated noise scale (TOO LARGE, > 4.00x)"));
+  e.fit_ratio = 4.0;  // equal is not above the threshold
+  EXPECT_THAT(to_text(decide_verdict(e, 0.9, 4.0), {}), HasSubstr("fit residual: 4.00x calibrated noise scale (ok, <= 4.00x)"));
+}
+
 // 4. a mismatch still names the unresolved fields as outside the verdict
 TEST(Verdict, MismatchNotesUnresolvedFields) {
   Evidence e = confident(Contract::identity(), kMiswired);
@@ -164,7 +181,7 @@ TEST(Report, TextHasTheReferenceLayout) {
                            "Declared pool:  8 candidate wirings\n"));
   EXPECT_THAT(t, HasSubstr("  permutation  (1, 0, 2, 3, 4, 5)               confidence 0.99\n"));
   EXPECT_THAT(t, HasSubstr("  gripper_inverted not checked (out of scope for a pose probe)\n"));
-  EXPECT_THAT(t, HasSubstr("  fit residual: 1.00x calibrated noise scale (ok)\n"));
+  EXPECT_THAT(t, HasSubstr("  fit residual: 1.00x calibrated noise scale (ok, <= 4.00x)\n"));
   EXPECT_THAT(t, HasSubstr("displacement during probing: 0.0123 m path over 6 probe steps"));
   EXPECT_THAT(t, HasSubstr("\nVERDICT: MISMATCH  (exit 1)\n  channels 0 and 1 SWAPPED; channel 3 sign FLIPPED\n"));
 }

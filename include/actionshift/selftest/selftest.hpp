@@ -65,6 +65,9 @@ struct Options {
   double amplitude{0.5};            ///< |raw| bound of every probe pose channel, in (0, 1]
   double confidence_floor{0.9};     ///< a field is resolved iff its confidence >= this, in (0, 1]
   double misspec_ratio{4.0};        ///< abstain if the MAP's fit ratio exceeds this, > 0
+  /// If set, the threshold when the MAP has absolute targets (an absolute command's response is not
+  /// what the delta-command gain calibration describes, so its residuals run on another scale), > 0.
+  std::optional<double> misspec_ratio_absolute;
   FrameRotation frame_rotation{FrameRotation::kMeasured};  ///< rotation for tool-frame decoding
   double min_frame_angle{0.2};      ///< [rad] frame is checked only if the TCP orientation stays at least this far from identity
   /// Entropy strategy: a channel whose commanded raw sum is non-zero may only be pulsed back towards
