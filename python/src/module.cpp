@@ -257,7 +257,7 @@ class PyEnv {
                           step_info(*r, env_.episode()));
   }
 
-  const std::string& task() const { return task_name_ = std::string(sim::task_name(env_.task())); }
+  std::string task() const { return std::string(sim::task_name(env_.task())); }
   int horizon() const { return env_.horizon(); }
   int obs_dim() const { return env_.layout().size(); }
   py::list layout() const {
@@ -279,7 +279,6 @@ class PyEnv {
   sim::HiddenContractEnv env_;
   std::string profile_, rotation_;
   std::optional<std::uint64_t> last_seed_;
-  mutable std::string task_name_;
 };
 
 // A fixed set of worker threads that run a function over [0, n) in chunks; the caller waits.
