@@ -609,9 +609,11 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 // an adapter by method name, with its task's calibration and (for pool methods) a pool
 std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
                                              py::object truth, py::object params) {
-  const nlohmann::json p = adapt::resolve_method_params(
-      method, nlohmann::json::parse(params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params)),
-                                    nullptr, false));
+  const std::string text =
+      params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params));
+  const nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);
+  if (parsed.is_discarded() || !parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
+  const nlohmann::json p = adapt::resolve_method_params(method, parsed);
   struct Holder {
     std::vector<Contract> pool;
     std::optional<Contract> truth;
