@@ -257,7 +257,7 @@ class PyEnv {
                           step_info(*r, env_.episode()));
   }
 
-  const std::string& task() const { return task_name_ = std::string(sim::task_name(env_.task())); }
+  std::string task() const { return std::string(sim::task_name(env_.task())); }
   int horizon() const { return env_.horizon(); }
   int obs_dim() const { return env_.layout().size(); }
   py::list layout() const {
@@ -279,7 +279,6 @@ class PyEnv {
   sim::HiddenContractEnv env_;
   std::string profile_, rotation_;
   std::optional<std::uint64_t> last_seed_;
-  mutable std::string task_name_;
 };
 
 // A fixed set of worker threads that run a function over [0, n) in chunks; the caller waits.
@@ -610,9 +609,11 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 // an adapter by method name, with its task's calibration and (for pool methods) a pool
 std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
                                              py::object truth, py::object params) {
-  const nlohmann::json p = adapt::resolve_method_params(
-      method, nlohmann::json::parse(params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params)),
-                                    nullptr, false));
+  const std::string text =
+      params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params));
+  const nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);
+  if (parsed.is_discarded() || !parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
+  const nlohmann::json p = adapt::resolve_method_params(method, parsed);
   struct Holder {
     std::vector<Contract> pool;
     std::optional<Contract> truth;
