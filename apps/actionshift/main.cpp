@@ -346,6 +346,8 @@ int main(int argc, char** argv) {
   render->add_option("--backbone", render_o.request.backbone, "Frozen policy")->capture_default_str();
   render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");
   render->add_option("--rotation-mode", render_o.request.rotation_mode, "live or identity")->capture_default_str();
+  render->add_option("--profile", render_o.request.profile, "Simulator fidelity profile: maniskill or ideal (as for run)")
+      ->capture_default_str();
   render->add_option("--contract", render_o.contract, "Contract index in the split")->capture_default_str();
   render->add_option("--episode", render_o.episode, "The contract's episode (0 = its first)")->capture_default_str();
   render->add_option("--camera", render_o.camera,

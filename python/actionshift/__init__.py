@@ -44,7 +44,7 @@ __all__ = [
     "methods", "pool_sha256", "selftest_library", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
 ]
 
-PROFILES = ("maniskill",)
+PROFILES = ("maniskill", "ideal")
 """Fidelity profiles this build's simulator accepts (``profile=`` of make/make_vec/evaluate)."""
 
 try:  # Gymnasium is optional: with it, environments subclass gymnasium.Env and are registered

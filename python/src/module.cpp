@@ -156,8 +156,11 @@ std::vector<Contract> to_contracts(py::handle h, const char* what) {
 // The one place a profile name becomes simulator settings. This build's simulator has a single
 // fidelity profile, "maniskill" (the default EnvConfig); every other name is rejected.
 sim::EnvConfig env_config_for_profile(const std::string& profile) {
-  if (profile == "maniskill") return sim::EnvConfig{};
-  throw InputError("profile", "", "unknown profile '" + profile + "' (this build has: maniskill)");
+  try {
+    return sim::profile_config(profile);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("profile", "", e.what());
+  }
 }
 
 // Env models are immutable and shareable; building one loads the robot, so they are cached.
@@ -562,8 +565,9 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
                   std::optional<std::string> pool, py::object params, const std::string& rotation,
                   const std::string& profile, const std::string& progress) {
   if (!PyCallable_Check(policy.ptr())) throw py::type_error("policy: must be callable (obs -> 7 numbers)");
-  env_config_for_profile(profile);  // only the default profile enters jobs in this build
+  env_config_for_profile(profile);  // validates the name
   eval::JobRequest q;
+  q.profile = profile;
   q.task = task;
   q.split = split;
   q.method.name = method;
