@@ -110,7 +110,6 @@ std::shared_ptr<const sim::EnvModel> sim_model(const SelftestOptions& o) {
 }
 
 int calibrate_misspec(const SelftestOptions& o, const selftest::Options& base, const adapt::ResponseCalibration& cal) {
-  const sim::TaskId task = sim::parse_task(o.task);
   const auto model = sim_model(o);
   std::map<std::string, std::vector<double>> fits;  // by target type of the true wiring
   int misidentified = 0, cut_short = 0;

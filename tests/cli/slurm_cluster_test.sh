@@ -107,6 +107,10 @@ methods: [oracle, no_adapt]
 seeds: [20260718, 20260719, 20260720]
 episodes: 3
 backbone: expert
+# the Slurm mechanics under test do not depend on the simulator's fidelity; on the ideal profile the
+# oracle solves these nine episodes, so the merge job's Gate 1 passes and the job COMPLETES (on the
+# default profile one of them fails, and the merge job correctly exits 1)
+profile: ideal
 YAML
 # MaxArraySize comes from `scontrol show config` (4): six jobs in two arrays
 "$AS" plan --experiment "$T/exp.yaml" --out "$T/results" --slurm --cpus-per-task 1 --time 5 >"$T/plan.out" 2>&1 \

@@ -98,8 +98,9 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
   missing.erase("return");
   EXPECT_THAT([&] { parse_record_line(missing.dump(), "r.jsonl:9"); },
               ThrowsMessage<InputError>(HasSubstr("r.jsonl:9: return: missing field")));
+  // a torn line names the field the parser was in when the text ended
   EXPECT_THAT([&] { parse_record_line(line.substr(0, 40), "r.jsonl:3"); },
-              ThrowsMessage<InputError>(HasSubstr("r.jsonl:3: not valid JSON")));
+              ThrowsMessage<InputError>(AllOf(HasSubstr("r.jsonl:3: "), HasSubstr("not valid JSON"))));
   EXPECT_THAT([&] { parse_record_line("[1,2]", "r.jsonl:3"); },
               ThrowsMessage<InputError>(HasSubstr("expected a JSON object per line")));
 }

@@ -11,7 +11,7 @@ mkdir -p "$WORK"
 cmake --install "$BUILD" --prefix "$WORK/prefix" > "$WORK/install.log"
 # only Eigen, nlohmann_json and OpenSSL may be found: every other dependency of the package is hidden
 HIDE=(-DCMAKE_DISABLE_FIND_PACKAGE_yaml-cpp=ON -DCMAKE_DISABLE_FIND_PACKAGE_urdfdom=ON
-      -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON -DCMAKE_DISABLE_FIND_PACKAGE_PkgConfig=ON
+      -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON
       -DCMAKE_DISABLE_FIND_PACKAGE_Threads=ON -DCMAKE_DISABLE_FIND_PACKAGE_GTest=ON)
 cmake -S "$EXAMPLE" -B "$WORK/build" -DCMAKE_PREFIX_PATH="$WORK/prefix" -DCMAKE_BUILD_TYPE=Release "${HIDE[@]}" \
   > "$WORK/configure.log" 2>&1 || { cat "$WORK/configure.log"; exit 1; }
