@@ -39,6 +39,7 @@ struct CalibrateOptions {
   std::string joint_limits;          // on | off: arm joint limit constraints
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table
+  bool gripper_channel{false};  // also fit the finger channel (optional "gripper" key)
 };
 int run_calibrate(const CalibrateOptions& o);
 

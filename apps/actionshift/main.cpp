@@ -277,6 +277,9 @@ int main(int argc, char** argv) {
   calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
   calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
+  calibrate->add_flag("--gripper-channel", cal_o.gripper_channel,
+                      "Also fit the finger channel (gripper action vs mean finger-position change per step), which\n"
+                      "grammar_belief uses with {\"gripper_channel\":true}; adds the optional \"gripper\" key");
   calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
 
   try {
