@@ -19,9 +19,9 @@ run "$AS" run --task pick_cube --split unseen_composition --method grammar_belie
   --threads 1 --out "$TMP/h" --progress off
 expect_rc 0 "grammar_belief hold probe"
 S=$(ls "$TMP"/h/*.summary.json)
-grep -q '"name":"grammar_belief"' "$S" && ok || bad "summary names the method"
-grep -q '"probe":"hold"' "$S" && ok || bad "the hold parameter enters the job"
-grep -q '"pool":null' "$S" && ok || bad "a grammar_belief job has no pool"
+grep -q '"name": "grammar_belief"' "$S" && ok || bad "summary names the method"
+grep -q '"probe": "hold"' "$S" && ok || bad "the hold parameter enters the job"
+grep -q '"pool": null' "$S" && ok || bad "a grammar_belief job has no pool"
 # probe steps are recorded (12 per episode for h2-r1, fewer if a safety check ended the episode)
 grep -q '"probe_steps":[1-9]' "$TMP"/h/*.jsonl && ok || bad "hold probe records its probe steps"
 # re-running the finished job is a no-op (hash-addressed)
