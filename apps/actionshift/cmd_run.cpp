@@ -121,6 +121,7 @@ int run_calibrate(const CalibrateOptions& o) {
   co.episodes = o.episodes;
   co.steps = o.steps;
   co.seed = o.seed;
+  co.gripper_channel = o.gripper_channel;
   const adapt::ResponseCalibration c = eval::calibrate(model, co);
   if (!o.out.empty()) {
     const std::filesystem::path p(o.out);
@@ -160,6 +161,10 @@ int run_calibrate(const CalibrateOptions& o) {
               << std::setprecision(3) << c.fit.fit_r2[i] << "\n";
   }
   std::cout << "mean R^2 over the six pose channels: " << std::setprecision(3) << mean_r2 << "\n";
+  if (c.gripper)
+    std::cout << std::left << std::setw(10) << "fingers" << std::right << std::setw(12) << std::setprecision(5)
+              << c.gripper->alpha << std::setw(16) << c.gripper->sigma << std::setw(9) << std::setprecision(3)
+              << c.gripper->fit_r2 << "   (finger block at observation offset " << c.gripper->start << ")\n";
   std::cout << "\ncalibration_sha256 " << c.sha256() << (o.out.empty() ? "" : "  written to " + o.out) << "\n";
   return kOk;
 }

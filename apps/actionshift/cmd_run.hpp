@@ -53,6 +53,7 @@ struct CalibrateOptions {
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table
   RobotOptions robot;  // --robot/--package
+  bool gripper_channel{false};  // also fit the finger channel (optional "gripper" key)
 };
 int run_calibrate(const CalibrateOptions& o);
 

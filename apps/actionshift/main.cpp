@@ -327,6 +327,9 @@ int main(int argc, char** argv) {
   calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
   add_robot_options(calibrate, cal_o.robot);
+  calibrate->add_flag("--gripper-channel", cal_o.gripper_channel,
+                      "Also fit the finger channel (gripper action vs mean finger-position change per step), which\n"
+                      "grammar_belief uses with {\"gripper_channel\":true}; adds the optional \"gripper\" key");
   calibrate->callback([&] { action = [&] { return cli::run_calibrate(cal_o); }; });
 
   // ---- render | montage | report (render layer)

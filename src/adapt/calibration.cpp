@@ -49,6 +49,18 @@ LinearFit fit_linear_response(const std::vector<Pose6>& x, const std::vector<Pos
   return f;
 }
 
+GripperFit fit_gripper_response(const std::vector<double>& x, const std::vector<double>& y, int start) {
+  if (x.empty() || x.size() != y.size())
+    throw std::invalid_argument("fit_gripper_response: need the same non-zero number of commands and responses");
+  std::vector<Pose6> px(x.size(), Pose6::Zero()), py(y.size(), Pose6::Zero());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    px[i][0] = x[i];
+    py[i][0] = y[i];
+  }
+  const LinearFit f = fit_linear_response(px, py);
+  return {start, f.alpha[0], f.sigma[0], f.fit_r2[0]};
+}
+
 std::string ResponseCalibration::to_json() const {
   nlohmann::json j;
   j["schema_version"] = kSchema;
@@ -64,6 +76,8 @@ std::string ResponseCalibration::to_json() const {
   j["rotation_mode"] = rotation_mode;
   j["profile"] = profile;
   j["protocol"] = protocol;
+  if (gripper)
+    j["gripper"] = {{"start", gripper->start}, {"alpha", gripper->alpha}, {"sigma", gripper->sigma}, {"fit_r2", gripper->fit_r2}};
   return canonical_dump(j);
 }
 
@@ -82,6 +96,7 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   for (auto it = j.begin(); it != j.end(); ++it) {
     bool known = false;
     for (std::size_t k = 0; k < nkeys; ++k) known = known || it.key() == kKeys[k];
+    known = known || (!v1 && it.key() == "gripper");
     if (!known) throw InputError(source, it.key(), "unknown field");
   }
   for (std::size_t k = 0; k < nkeys; ++k)
@@ -123,6 +138,27 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   six("alpha", c.fit.alpha);
   six("sigma", c.fit.sigma);
   six("fit_r2", c.fit.fit_r2);
+  if (j.contains("gripper")) {
+    const auto& g = j["gripper"];
+    if (!g.is_object()) throw InputError(source, "gripper", "must be an object {alpha, fit_r2, sigma, start}");
+    for (auto it = g.begin(); it != g.end(); ++it)
+      if (it.key() != "alpha" && it.key() != "fit_r2" && it.key() != "sigma" && it.key() != "start")
+        throw InputError(source, "gripper." + it.key(), "unknown field");
+    GripperFit gf;
+    for (const char* k : {"alpha", "fit_r2", "sigma"}) {
+      if (!g.contains(k) || !g[k].is_number() || !std::isfinite(g[k].get<double>()))
+        throw InputError(source, std::string("gripper.") + k, "must be a finite number");
+    }
+    if (!g.contains("start") || !g["start"].is_number_integer() || g["start"].get<long long>() < 0)
+      throw InputError(source, "gripper.start", "must be an integer >= 0");
+    gf.start = static_cast<int>(g["start"].get<long long>());
+    gf.alpha = g["alpha"].get<double>();
+    gf.sigma = g["sigma"].get<double>();
+    gf.fit_r2 = g["fit_r2"].get<double>();
+    if (!(gf.sigma > 0.0)) throw InputError(source, "gripper.sigma", "must be positive");
+    if (gf.alpha == 0.0) throw InputError(source, "gripper.alpha", "must be non-zero");
+    c.gripper = gf;
+  }
   try {
     c.model().validate();
   } catch (const std::invalid_argument& e) {

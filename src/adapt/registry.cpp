@@ -1,26 +1,32 @@
 #include "actionshift/adapt/registry.hpp"
 
+#include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/methods.hpp"
 #include "actionshift/core/error.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <string>
 
 namespace actionshift::adapt {
 
 const std::vector<std::string>& method_names() {
   static const std::vector<std::string> n{"oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes",
-                                          "exact_belief", "no_adapt"};
+                                          "exact_belief", "grammar_belief", "no_adapt"};
   return n;
 }
 
-bool method_needs_pool(const std::string& m) { return m != "oracle" && m != "no_adapt"; }
-bool method_needs_calibration(const std::string& m) { return method_needs_pool(m); }
+bool method_needs_pool(const std::string& m) { return m != "oracle" && m != "no_adapt" && m != "grammar_belief"; }
+bool method_needs_calibration(const std::string& m) { return method_needs_pool(m) || m == "grammar_belief"; }
 
 namespace {
 
 nlohmann::json defaults(const std::string& m) {
   if (m == "oracle" || m == "no_adapt" || m == "exact_belief") return nlohmann::json::object();
+  if (m == "grammar_belief")  // the reference's operating points: 6 fixed pulses of 0.5; hold h2-r1 over 6 channels
+    return {{"probe", "none"},     {"budget", 6},        {"amplitude", 0.5},          {"hold_steps", 2},
+            {"hold_rounds", 1},    {"hold_channels", 6}, {"after_probe", "belief"}, {"gripper_channel", false}};
   nlohmann::json p = {{"budget", 6}, {"amplitude", 0.5}};
   if (m == "entropy_probes" || m == "dualabi") {
     p["calibrated_preview"] = true;
@@ -65,7 +71,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
     if (!out.contains(it.key())) throw InputError("method " + method, it.key(), "unknown parameter");
     const auto& d = out[it.key()];
     const auto& v = it.value();
-    const bool ok = (d.is_boolean() && v.is_boolean()) || (d.is_number_integer() && v.is_number_integer()) ||
+    const bool ok = (d.is_string() && v.is_string()) || (d.is_boolean() && v.is_boolean()) || (d.is_number_integer() && v.is_number_integer()) ||
                     (d.is_number_float() && v.is_number());
     if (!ok) throw InputError("method " + method, it.key(), "wrong type (expected like " + d.dump() + ")");
     out[it.key()] = d.is_number_float() ? nlohmann::json(v.get<double>()) : v;
@@ -83,11 +89,45 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   if (out.contains("entropy_tolerance") && !(out["entropy_tolerance"].get<double>() >= 0.0))
     throw InputError("method " + method, "entropy_tolerance", "must be nonnegative");
   if (out.contains("window") && out["window"].get<int>() < 1) throw InputError("method " + method, "window", "must be at least 1");
+  auto one_of = [&](const char* key, std::initializer_list<const char*> allowed) {
+    if (!out.contains(key)) return;
+    const auto v = out[key].get<std::string>();
+    std::string list;
+    for (const char* a : allowed) {
+      if (v == a) return;
+      list += (list.empty() ? "" : ", ") + std::string(a);
+    }
+    throw InputError("method " + method, key, "must be one of " + list + " (got '" + v + "')");
+  };
+  one_of("probe", {"none", "fixed", "hold"});
+  one_of("after_probe", {"belief", "identity"});
+  auto int_in = [&](const char* key, int lo, int hi) {
+    if (out.contains(key) && (out[key].get<int>() < lo || out[key].get<int>() > hi))
+      throw InputError("method " + method, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  };
+  int_in("hold_steps", 2, 1000);
+  int_in("hold_rounds", 1, 1000);
+  int_in("hold_channels", 1, kPoseDim);
   return out;
 }
 
 std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& p, const MethodInputs& in) {
   if (method == "no_adapt") return std::make_unique<NoAdaptAdapter>();
+  if (method == "grammar_belief") {  // grammar + calibration only: never given the truth or the pool
+    if (!in.model) throw InputError("method", method, "needs a response calibration");
+    GrammarOptions o;
+    const auto probe = p.at("probe").get<std::string>();
+    o.probe = probe == "fixed" ? GrammarProbe::kFixed : probe == "hold" ? GrammarProbe::kHold : GrammarProbe::kNone;
+    o.budget = p.at("budget").get<int>();
+    o.amplitude = p.at("amplitude").get<double>();
+    o.hold = HoldSchedule(o.amplitude, p.at("hold_steps").get<int>(), p.at("hold_rounds").get<int>(), p.at("hold_channels").get<int>());
+    o.belief_after_probe = p.at("after_probe").get<std::string>() == "belief";
+    o.gripper_channel = p.at("gripper_channel").get<bool>();
+    if (o.gripper_channel && !in.model->has_gripper())
+      throw InputError("method grammar_belief", "gripper_channel",
+                       "the task's calibration has no finger channel (run `actionshift calibrate --gripper-channel`)");
+    return std::make_unique<GrammarBeliefAdapter>(*in.model, o);
+  }
   if (method == "oracle") {
     if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given only by the runner)");
     return std::make_unique<OracleAdapter>(*in.truth);

@@ -66,6 +66,10 @@ void ResponseModel::validate() const {
     if (!std::isfinite(sigma[k]) || sigma[k] <= 0.0)
       throw std::invalid_argument("response model: sigma[" + std::to_string(c) + "] must be finite and positive");
   }
+  if (!std::isfinite(gripper_sigma) || gripper_sigma < 0.0)
+    throw std::invalid_argument("response model: gripper_sigma must be finite and nonnegative");
+  if (has_gripper() && (!std::isfinite(gripper_alpha) || gripper_alpha == 0.0))
+    throw std::invalid_argument("response model: gripper_alpha must be finite and non-zero");
 }
 
 }  // namespace actionshift::adapt

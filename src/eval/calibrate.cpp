@@ -15,6 +15,12 @@ adapt::TcpSlice tcp_slice(const sim::ObservationLayout& layout) {
   return {f->offset, f->offset + 3};
 }
 
+int finger_start(const sim::ObservationLayout& layout) {
+  const sim::ObsField* f = layout.find("qpos");
+  if (!f || f->width != 9) throw std::invalid_argument("observation layout has no 9-wide qpos field");
+  return f->offset + 7;
+}
+
 std::string_view protocol_name(CalibrationProtocol p) {
   return p == CalibrationProtocol::kReferenceWalk ? "reference_walk" : "episodes";
 }
@@ -44,6 +50,8 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
   }
   sim::Env env(model);
   std::vector<Pose6> commanded, observed;
+  std::vector<double> grip_cmd, grip_obs;
+  const int fs = o.gripper_channel ? finger_start(model->layout()) : -1;
   for (int e = 0; e < o.episodes; ++e) {
     Eigen::VectorXd prev = env.reset(derive_seed({o.seed, static_cast<std::uint64_t>(e)}));
     Rng rng(derive_seed({o.seed, static_cast<std::uint64_t>(e), 1}));
@@ -55,6 +63,10 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
       if (!walk || t > 0) {  // the reference records states after each step: no sample for step 0
         commanded.push_back(a.head<kPoseDim>());
         observed.push_back(adapt::tcp_response(prev, r.obs, slice));
+        if (fs >= 0) {
+          grip_cmd.push_back(a[kGripper]);
+          grip_obs.push_back(0.5 * (r.obs[fs] + r.obs[fs + 1]) - 0.5 * (prev[fs] + prev[fs + 1]));
+        }
       }
       prev = r.obs;
       if (r.episode_over()) break;
@@ -70,6 +82,7 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
   c.rotation_mode = "live";
   c.profile = model->config().profile;
   c.protocol = std::string(protocol_name(o.protocol));
+  if (fs >= 0) c.gripper = adapt::fit_gripper_response(grip_cmd, grip_obs, fs);
   return c;
 }
 

@@ -89,6 +89,7 @@ struct Context {
   std::vector<Contract> pool;
   std::optional<adapt::ResponseModel> response;
   adapt::TcpSlice slice;
+  int finger_start{-1};  // the finger channel's offset, when the calibration has one
   std::shared_ptr<const policy::Policy> prototype;
   nlohmann::json params;
   sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
@@ -146,6 +147,10 @@ struct Context {
       if (probe) {
         ++rec.probe_steps;
         rec.probe_displacement += response_now.head<3>().norm();
+      }
+      if (finger_start >= 0) {
+        const auto f = static_cast<Eigen::Index>(finger_start);
+        adapter->observe_fingers(0.5 * (r.obs[f] + r.obs[f + 1]) - 0.5 * (obs[f] + obs[f + 1]));
       }
       adapter->observe(raw, response_now, R);
       obs = r.obs;
@@ -223,6 +228,11 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
     if (cal.slice.position_start != ctx->slice.position_start || cal.slice.quaternion_start != ctx->slice.quaternion_start)
       throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
     ctx->response = cal.model();
+    if (cal.gripper) {
+      if (cal.gripper->start != finger_start(ctx->model->layout()))
+        throw InputError("calibration " + job.task, "gripper.start", "does not match the task's observation layout");
+      ctx->finger_start = cal.gripper->start;
+    }
   }
   if (backbone->name() != job.backbone.name)
     throw InputError("backbone " + backbone->name(), "name", "is not the job's backbone " + job.backbone.name);
@@ -232,6 +242,11 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
   if (ctx->prototype->sha256() != job.backbone.sha256)
     throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
   ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));
+  if (job.method == "grammar_belief") {  // parameters that need the calibration fail here, before any episode
+    adapt::MethodInputs in;
+    in.model = ctx->response ? &*ctx->response : nullptr;
+    adapt::make_adapter(job.method, ctx->params, in);
+  }
   return [ctx](const EpisodeTask& t) { return ctx->run(t); };
 }
 

@@ -1,6 +1,8 @@
 // Per-environment-step cost of the pool belief and probe selection. Budgets (issue 6): belief
 // update <= 2 us for 9 hypotheses and <= 20 us for the full pool; entropy or DualABI selection
-// <= 50 us per step for 9 hypotheses.
+// <= 50 us per step for 9 hypotheses. Grammar belief (issue 11): one update <= 20 us; one action
+// selection (MAP resolution over the 8 modes and the encode) <= 200 us.
+#include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/methods.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
@@ -63,5 +65,39 @@ void BM_DualAbiSelect(benchmark::State& state) {
   state.SetLabel(std::to_string(d.belief().size()) + " hypotheses");
 }
 BENCHMARK(BM_DualAbiSelect)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+
+void BM_GrammarUpdate(benchmark::State& state) {
+  GrammarBelief b(kModel);
+  Decoder env(reference::representative_contracts("unseen_composition")[1]);
+  int k = 0;
+  for (auto _ : state) {
+    const Action raw = intent(k++);
+    b.update(raw, kModel.expected(env.step(raw)));
+    if (k % 50 == 0) b.reset();
+  }
+  benchmark::DoNotOptimize(b.evidence(0, 0, 0, 0, 0));
+}
+BENCHMARK(BM_GrammarUpdate);
+
+// one step's action selection: the MAP is stale after every update, so each iteration resolves it
+// (8 modes: best sign/scale per cell and an exact 6x6 assignment) and encodes
+void BM_GrammarSelect(benchmark::State& state) {
+  GrammarBelief b(kModel);
+  Decoder env(reference::representative_contracts("seen")[1]);
+  for (int k = 0; k < 20; ++k) {
+    const Action raw = intent(k);
+    b.update(raw, kModel.expected(env.step(raw)));
+  }
+  int k = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Action raw = intent(k++);
+    b.update(raw, kModel.expected(env.step(raw)));
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(b.map_encode(intent(k), false));
+  }
+}
+BENCHMARK(BM_GrammarSelect);
 
 }  // namespace

@@ -34,6 +34,10 @@ class Adapter {
   /// After the step: the raw action that was sent (encode's result), the TCP response it
   /// caused (translation, rotation vector) and the same `R` as given to encode().
   virtual void observe(const Action& raw, const Pose6& response, const Mat3& R) = 0;
+  /// The seventh evidence channel: the change of the mean finger position [m] over the coming
+  /// observe()'s step. The runner calls it just before observe(), and only when the task's
+  /// calibration has a finger channel; adapters that do not use it ignore it.
+  virtual void observe_fingers(double /*finger_delta*/) {}
   /// What the last encode() did.
   virtual StepInfo last_step() const { return {}; }
 };

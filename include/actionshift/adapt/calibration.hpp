@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,19 @@ struct LinearFit {
 /// (reference `fit_linear_response`). Throws std::invalid_argument if sizes differ or are empty.
 LinearFit fit_linear_response(const std::vector<Pose6>& commanded, const std::vector<Pose6>& observed);
 
+/// The finger channel's fit (reference §4.5): command = the gripper action, observed = the change
+/// of the mean finger position (m) over the step.
+struct GripperFit {
+  int start{-1};        ///< offset of the two finger joint positions in the observation
+  double alpha{0.0};    ///< Σxy / Σx²
+  double sigma{0.0};    ///< population std of the residual, floored at 1e-4
+  double fit_r2{0.0};
+};
+
+/// Fits the finger channel (same rules as fit_linear_response). Throws std::invalid_argument if the
+/// sizes differ or are empty.
+GripperFit fit_gripper_response(const std::vector<double>& commanded, const std::vector<double>& observed, int start);
+
 /// A task's calibration, as stored in configs/calibration/<task>.json.
 struct ResponseCalibration {
   std::string task;                ///< e.g. "pick_cube"
@@ -37,8 +51,18 @@ struct ResponseCalibration {
   std::string rotation_mode{"live"};  ///< how canonical rotation commands were applied (always live: unwrapped env)
   std::string profile{"maniskill"};   ///< simulator fidelity profile it was measured on
   std::string protocol{"reference_walk"};  ///< "reference_walk" (8 walks x 64 steps) or "episodes"
+  /// The finger channel, when calibrated (`calibrate --gripper-channel`). Optional key "gripper"
+  /// of the JSON: a file without it serialises (and hashes) exactly as before.
+  std::optional<GripperFit> gripper;
 
-  ResponseModel model() const { return {fit.alpha, fit.sigma}; }
+  ResponseModel model() const {
+    ResponseModel m{fit.alpha, fit.sigma};
+    if (gripper) {
+      m.gripper_alpha = gripper->alpha;
+      m.gripper_sigma = gripper->sigma;
+    }
+    return m;
+  }
   /// Canonical JSON (sorted keys, Python-repr floats; schema "actionshift-calibration/2", which adds
   /// "profile" and "protocol" to /1; /1 files still load, as profile "ideal", protocol "episodes").
   std::string to_json() const;

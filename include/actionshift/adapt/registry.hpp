@@ -1,6 +1,7 @@
 #pragma once
 /// \file Adapter methods by name, with their parameters as a JSON object (the form that enters job
-/// specs): oracle, no_adapt, exact_belief, fixed_probes, random_probes, entropy_probes, dualabi.
+/// specs): oracle, no_adapt, exact_belief, fixed_probes, random_probes, entropy_probes, dualabi,
+/// grammar_belief (grammar + calibration only; no pool).
 
 #include "actionshift/adapt/adapter.hpp"
 #include "actionshift/adapt/response.hpp"

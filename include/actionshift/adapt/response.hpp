@@ -46,8 +46,16 @@ inline Mat3 tcp_rotation(const Eigen::VectorXd& obs, const TcpSlice& slice) { re
 struct ResponseModel {
   std::array<double, kPoseDim> alpha{1, 1, 1, 1, 1, 1};  ///< response per unit canonical command (m or rad)
   std::array<double, kPoseDim> sigma{1, 1, 1, 1, 1, 1};  ///< noise std of the response (m or rad), > 0
+  /// Optional seventh channel (the reference's "v2 finger evidence"): the mean finger-position
+  /// change per step ≈ gripper_alpha · canonical gripper command, noise gripper_sigma [m].
+  /// gripper_sigma == 0 means the channel is not calibrated.
+  double gripper_alpha{0.0};
+  double gripper_sigma{0.0};
 
-  /// Throws std::invalid_argument unless every α is finite and non-zero and every σ finite > 0.
+  bool has_gripper() const noexcept { return gripper_sigma > 0.0; }
+
+  /// Throws std::invalid_argument unless every α is finite and non-zero and every σ finite > 0
+  /// (and, with a finger channel, its α finite and non-zero and its σ finite > 0).
   void validate() const;
 
   /// α ⊙ canonical pose.

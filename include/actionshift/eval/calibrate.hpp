@@ -32,7 +32,14 @@ struct CalibrationOptions {
   int episodes{8};                  ///< random walks (reference: 8 environments) or episodes
   int steps{64};                    ///< control steps per walk (reference: 64) or per episode
   std::uint64_t seed{20260720};     ///< the reference's calibration seed
+  /// Also fit the finger channel (reference §4.5): gripper action vs the change of the mean of the
+  /// two finger joint positions (qpos[7:9]) over each step. Adds the optional "gripper" key.
+  bool gripper_channel{false};
 };
+
+/// Offset of the two finger joint positions in a task's observation (qpos[7], qpos[8]).
+/// Throws std::invalid_argument if the layout has no 9-wide qpos field.
+int finger_start(const sim::ObservationLayout& layout);
 
 /// Where the TCP pose is in a task's observation ("tcp_pose": position xyz then quaternion wxyz).
 /// Throws std::invalid_argument if the layout has no 7-wide tcp_pose field.
