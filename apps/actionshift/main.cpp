@@ -1,6 +1,7 @@
 // The actionshift command-line tool: the only translation unit that includes CLI11.
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
+#include "cmd_bench_adapt.hpp"
 #include "cmd_policy.hpp"
 #include "cmd_render.hpp"
 #include "cmd_run.hpp"
@@ -94,6 +95,32 @@ int main(int argc, char** argv) {
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
   add_robot_options(bench_env, bench_env_o.robot);
   bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
+
+  // ---- bench adapt (adapt layer)
+  cli::BenchAdaptOptions bench_adapt_o;
+  auto* bench_adapt = bench->add_subcommand(
+      "adapt", "Per-step cost of an adapter configuration on synthetic episodes: the true contract of each episode\n"
+               "is a pool member, the response is the task's calibrated response model plus its noise, the TCP\n"
+               "orientation turns slowly. Reports the first selection of an episode (from the uniform belief),\n"
+               "encode on probe and on task steps, observe (the belief update) and the whole step, in microseconds\n"
+               "(medians over repetitions, one thread). See docs/results/benchmarks.md.");
+  bench_adapt->add_option("--method", bench_adapt_o.method, "Adapter method (docs/adapters.md)")->capture_default_str();
+  bench_adapt->add_option("--pool", bench_adapt_o.pool, "Declared pool: reference9, full or a pool manifest file (pool methods)")
+      ->capture_default_str();
+  bench_adapt->add_option("--params", bench_adapt_o.params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
+      ->capture_default_str();
+  bench_adapt->add_option("--task", bench_adapt_o.task, "Task whose built-in response calibration is the response model")
+      ->capture_default_str();
+  bench_adapt->add_option("--profile", bench_adapt_o.profile, "Simulator fidelity profile of that calibration: maniskill or ideal")
+      ->capture_default_str();
+  bench_adapt->add_option("--episodes", bench_adapt_o.episodes, "Episodes per repetition")->capture_default_str()->check(CLI::PositiveNumber);
+  bench_adapt->add_option("--steps", bench_adapt_o.steps, "Control steps per episode")->capture_default_str()->check(CLI::PositiveNumber);
+  bench_adapt->add_option("--repetitions", bench_adapt_o.repetitions, "Repetitions (the figures are their medians)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  bench_adapt->add_option("--seed", bench_adapt_o.seed, "Seed of the synthetic episodes")->capture_default_str();
+  bench_adapt->add_flag("--json", bench_adapt_o.json, "Print one JSON object");
+  bench_adapt->callback([&] { action = [&] { return cli::run_bench_adapt(bench_adapt_o); }; });
 
   // ---- selftest (plug-and-verify; its own exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input)
   cli::SelftestOptions st_o;

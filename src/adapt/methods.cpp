@@ -2,6 +2,8 @@
 
 #include "actionshift/core/transforms.hpp"
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -28,19 +30,9 @@ Action fixed_probe_pulse(int step, double amplitude) {
 }
 
 std::vector<int> active_hypotheses(const Eigen::VectorXd& p, int max_active, double mass) {
-  const int n = static_cast<int>(p.size());
-  std::vector<int> order(static_cast<std::size_t>(n));
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return p[a] > p[b]; });
-  std::vector<int> out;
-  double covered = 0;
-  for (int i : order) {
-    if (static_cast<int>(out.size()) >= std::max(1, max_active)) break;
-    if (!out.empty() && covered >= mass) break;
-    out.push_back(i);
-    covered += p[i];
-  }
-  std::sort(out.begin(), out.end());
+  std::vector<int> order(static_cast<std::size_t>(p.size()));
+  std::vector<int> out(std::min(order.size(), static_cast<std::size_t>(std::max(1, max_active))));
+  out.resize(static_cast<std::size_t>(active_set(p, max_active, mass, order, out)));
   return out;
 }
 
@@ -52,83 +44,32 @@ void check_options(const ProbeOptions& o) {
   if (o.max_active < 1) throw std::invalid_argument("max_active must be at least 1");
 }
 
-// the observation a hypothesis predicts for its own prediction (see the header's two differences)
-Pose6 simulated_observation(const ResponseModel& m, const Action& pred, bool calibrated) {
-  return calibrated ? m.expected(pred) : Pose6(pred.head<kPoseDim>());
-}
-
-// posterior over `active` after observing `obs`, given the current log belief; returns its
-// entropy [nats] (one exp per hypothesis and a single log)
-double posterior(const PoolBelief& b, const std::vector<int>& active, const std::vector<Action>& preds, const Pose6& obs,
-                 Eigen::VectorXd& out) {
-  const auto& logp = b.log_probs();
-  const auto n = static_cast<Eigen::Index>(active.size());
-  out.resize(n);
-  double m = -std::numeric_limits<double>::infinity();
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const int h = active[static_cast<std::size_t>(j)];
-    out[j] = logp[h] + b.model().log_likelihood(preds[static_cast<std::size_t>(h)], obs);
-    m = std::max(m, out[j]);
-  }
-  double sum = 0, weighted = 0;
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const double x = out[j] - m;
-    const double e = std::exp(x);
-    out[j] = e;
-    sum += e;
-    weighted += e * x;
-  }
-  out /= sum;
-  return std::log(sum) - weighted / sum;  // −Σ p ln p with ln p = x − ln Σe
-}
-
-// the belief restricted to its active hypotheses (ProbeOptions::max_active / active_mass)
-struct ActiveBelief {
-  Eigen::VectorXd p;        // probabilities of every hypothesis
-  std::vector<int> active;  // indices, increasing
-  double mass{0};           // Σ p over `active`
-};
-
-ActiveBelief active_belief(const PoolBelief& b, const ProbeOptions& o) {
-  ActiveBelief a;
-  a.p = b.probs();
-  a.active = active_hypotheses(a.p, o.max_active, o.active_mass);
-  for (int h : a.active) a.mass += a.p[h];
-  return a;
+const ProbeOptions& checked(const ProbeOptions& o) {
+  check_options(o);
+  return o;
 }
 
 }  // namespace
 
 std::vector<double> expected_posterior_entropy(const PoolBelief& b, const std::vector<Action>& candidates, const Mat3& R,
                                                const ProbeOptions& o) {
-  const auto [p, active, mass] = active_belief(b, o);
-  std::vector<Action> preds;
-  Eigen::VectorXd post;
+  ProbeSelector sel(b.size(), o.max_active);
+  sel.select_active(b, o.max_active, o.active_mass);
   std::vector<double> out;
   out.reserve(candidates.size());
-  for (const auto& c : candidates) {
-    b.preview(c, R, o.lag_aware_preview, preds);
-    double eh = 0;
-    for (int h : active) {
-      const double ent = posterior(b, active, preds,
-                                   simulated_observation(b.model(), preds[static_cast<std::size_t>(h)], o.calibrated_preview), post);
-      eh += p[h] / mass * ent;
-    }
-    out.push_back(eh);
-  }
+  for (const auto& c : candidates) out.push_back(sel.expected_entropy(b, c, R, o.calibrated_preview, o.lag_aware_preview));
   return out;
 }
 
 std::vector<double> expected_response_magnitude(const PoolBelief& b, const std::vector<Action>& candidates, const Mat3& R,
                                                 const ProbeOptions& o) {
-  const auto [p, active, mass] = active_belief(b, o);
-  std::vector<Action> preds;
+  ProbeSelector sel(b.size(), o.max_active);
+  sel.select_active(b, o.max_active, o.active_mass);
   std::vector<double> out;
   out.reserve(candidates.size());
   for (const auto& c : candidates) {
-    b.preview(c, R, o.lag_aware_preview, preds);
     double m = 0;
-    for (int h : active) m += p[h] / mass * b.model().expected(preds[static_cast<std::size_t>(h)]).norm();
+    sel.expected_entropy(b, c, R, o.calibrated_preview, o.lag_aware_preview, &m);
     out.push_back(m);
   }
   return out;
@@ -137,9 +78,11 @@ std::vector<double> expected_response_magnitude(const PoolBelief& b, const std::
 // ---- probing
 
 ProbingAdapter::ProbingAdapter(std::vector<Contract> pool, ResponseModel model, ProbeStrategy strategy, ProbeOptions options)
-    : belief_(std::move(pool), model), strategy_(strategy), options_(options), candidates_(probe_candidates(options.amplitude)) {
-  check_options(options_);
-}
+    : belief_(std::move(pool), model),
+      strategy_(strategy),
+      options_(checked(options)),
+      selector_(belief_.size(), options_.max_active),
+      candidates_(probe_candidates(options.amplitude)) {}
 
 std::string ProbingAdapter::name() const {
   switch (strategy_) {
@@ -171,14 +114,17 @@ Action ProbingAdapter::encode(const Action& canonical, const Mat3& R) {
       return a;
     }
     default: {
-      const auto eh = expected_posterior_entropy(belief_, candidates_, R, options_);
+      selector_.select_active(belief_, options_.max_active, options_.active_mass);
+      std::array<double, kNumCandidates> eh, motion;
+      for (std::size_t i = 0; i < kNumCandidates; ++i)
+        eh[i] = selector_.expected_entropy(belief_, candidates_[i], R, options_.calibrated_preview, options_.lag_aware_preview,
+                                           options_.motion_tiebreak ? &motion[i] : nullptr);
       std::size_t best = 0;
-      for (std::size_t i = 1; i < eh.size(); ++i)
+      for (std::size_t i = 1; i < kNumCandidates; ++i)
         if (eh[i] < eh[best]) best = i;
       if (options_.motion_tiebreak) {
-        const auto motion = expected_response_magnitude(belief_, candidates_, R, options_);
         const double cutoff = eh[best] + options_.entropy_tolerance;
-        for (std::size_t i = 0; i < eh.size(); ++i)
+        for (std::size_t i = 0; i < kNumCandidates; ++i)
           if (eh[i] <= cutoff && motion[i] < motion[best]) best = i;
       }
       return candidates_[best];
@@ -192,10 +138,10 @@ DualAbiAdapter::DualAbiAdapter(std::vector<Contract> pool, ResponseModel model, 
                                int window)
     : belief_(std::move(pool), model),
       threshold_(regret_threshold),
-      options_(options),
+      options_(checked(options)),
       window_(window),
+      selector_(belief_.size(), options_.max_active, std::max(window, 0)),
       candidates_(probe_candidates(options.amplitude)) {
-  check_options(options_);
   if (window_ < 1) throw std::invalid_argument("DualABI recent window must be at least 1");
   if (!std::isfinite(threshold_) || threshold_ < 0) throw std::invalid_argument("DualABI regret threshold must be finite and nonnegative");
   recent_.assign(static_cast<std::size_t>(window_), Action::Zero());
@@ -220,22 +166,10 @@ void DualAbiAdapter::push_recent(const Action& a) {
 }
 
 Eigen::MatrixXd DualAbiAdapter::pairwise_task_error(const std::vector<int>& active, const Mat3& R) const {
-  const auto n = static_cast<Eigen::Index>(active.size());
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, n);
-  const double inv_w = 1.0 / static_cast<double>(recent_.size());
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto& ri = belief_.replica(active[static_cast<std::size_t>(i)]);
-    for (const Action& a : recent_) {
-      const Action raw = actionshift::encode(ri.contract(), a, R, ri.tracked_target());
-      for (Eigen::Index j = 0; j < n; ++j) {
-        if (j == i) continue;
-        const auto& rj = belief_.replica(active[static_cast<std::size_t>(j)]);
-        const Action exec = actionshift::decode(rj.contract(), raw, R, rj.tracked_target());
-        E(i, j) += (exec.head<kPoseDim>() - a.head<kPoseDim>()).norm() * inv_w;
-      }
-    }
-  }
-  return E;
+  ProbeSelector sel(belief_.size(), static_cast<int>(active.size()), window_);
+  sel.set_active(belief_, active);
+  sel.compute_task_error(belief_, recent_, R);
+  return sel.task_error();
 }
 
 double DualAbiAdapter::regret(const Eigen::VectorXd& p, const Eigen::MatrixXd& E) {
@@ -247,23 +181,12 @@ double DualAbiAdapter::regret(const Eigen::VectorXd& p, const Eigen::MatrixXd& E
 
 std::vector<double> DualAbiAdapter::expected_future_regret(const std::vector<int>& active, const Eigen::MatrixXd& E,
                                                            const Mat3& R) const {
-  const Eigen::VectorXd p_all = belief_.probs();
-  Eigen::VectorXd p(static_cast<Eigen::Index>(active.size()));
-  for (std::size_t j = 0; j < active.size(); ++j) p[static_cast<Eigen::Index>(j)] = p_all[active[j]];
-  const double mass = p.sum();
-  std::vector<Action> preds;
-  Eigen::VectorXd post;
+  ProbeSelector sel(belief_.size(), static_cast<int>(active.size()), window_);
+  sel.set_active(belief_, active);
+  sel.set_task_error(E);
   std::vector<double> out;
-  for (const auto& c : candidates_) {
-    belief_.preview(c, R, options_.lag_aware_preview, preds);
-    double ef = 0;
-    for (std::size_t h = 0; h < active.size(); ++h) {
-      posterior(belief_, active, preds,
-                simulated_observation(belief_.model(), preds[static_cast<std::size_t>(active[h])], options_.calibrated_preview), post);
-      ef += p[static_cast<Eigen::Index>(h)] / mass * regret(post, E);
-    }
-    out.push_back(ef);
-  }
+  for (const auto& c : candidates_)
+    out.push_back(sel.expected_future_regret(belief_, c, R, options_.calibrated_preview, options_.lag_aware_preview));
   return out;
 }
 
@@ -274,19 +197,17 @@ Action DualAbiAdapter::encode(const Action& canonical, const Mat3& R) {
   ++steps_;
   last_ = {false, -1.0};
   if (!eligible) return task;
-  const Eigen::VectorXd p_all = belief_.probs();
-  const std::vector<int> active = active_hypotheses(p_all, options_.max_active, options_.active_mass);
-  const Eigen::MatrixXd E = pairwise_task_error(active, R);
-  Eigen::VectorXd p(static_cast<Eigen::Index>(active.size()));
-  for (std::size_t j = 0; j < active.size(); ++j) p[static_cast<Eigen::Index>(j)] = p_all[active[j]];
-  p /= p.sum();
-  const double current = regret(p, E);
+  selector_.select_active(belief_, options_.max_active, options_.active_mass);
+  selector_.compute_task_error(belief_, recent_, R);
+  const double current = selector_.current_regret();
   last_.task_regret = current;
   if (current < threshold_) {  // sticky: no more probing this episode
     stopped_ = true;
     return task;
   }
-  const auto ef = expected_future_regret(active, E, R);
+  std::array<double, kNumCandidates> ef;
+  for (std::size_t c = 0; c < kNumCandidates; ++c)
+    ef[c] = selector_.expected_future_regret(belief_, candidates_[c], R, options_.calibrated_preview, options_.lag_aware_preview);
   std::size_t best = 0;
   double best_score = -1;
   for (std::size_t c = 0; c < ef.size(); ++c) {

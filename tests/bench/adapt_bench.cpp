@@ -1,7 +1,10 @@
-// Per-environment-step cost of the pool belief and probe selection. Budgets (issue 6): belief
-// update <= 2 us for 9 hypotheses and <= 20 us for the full pool; entropy or DualABI selection
-// <= 50 us per step for 9 hypotheses. Grammar belief (issue 11): one update <= 20 us; one action
-// selection (MAP resolution over the 8 modes and the encode) <= 200 us.
+// Per-environment-step cost of the pool belief and probe selection. Budgets: belief update <= 2 us
+// for 9 hypotheses and <= 20 us for the full pool (issue 6); entropy selection <= 8 us and DualABI
+// <= 15 us for 9 hypotheses, <= 60 us and <= 90 us for the full pool (issue 18). The batched belief
+// is timed per call at 1, 8 and 1024 environments. scripts/bench_adapt_table regenerates the table
+// in docs/results/benchmarks.md from this executable's JSON output. Grammar belief (issue 11): one update
+// <= 20 us; one action selection (MAP resolution over the 8 modes and the encode) <= 200 us.
+#include "actionshift/adapt/batched_belief.hpp"
 #include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/methods.hpp"
 #include "actionshift/core/reference_contracts.hpp"
@@ -99,5 +102,33 @@ void BM_GrammarSelect(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_GrammarSelect);
+// one batched update of n environments (inputs precomputed: a 50-step episode per environment)
+void BM_BatchedBeliefUpdate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(1));
+  constexpr int kSteps = 50;
+  BatchedPoolBelief b(pool(static_cast<int>(state.range(0))), kModel, n);
+  Decoder env(reference::oracle_contract(), n);
+  std::vector<BatchedPoolBelief::Batch> raw(kSteps, BatchedPoolBelief::Batch(kActionDim, n));
+  std::vector<BatchedPoolBelief::PoseBatch> obs(kSteps, BatchedPoolBelief::PoseBatch(kPoseDim, n));
+  BatchedPoolBelief::Batch exec(kActionDim, n);
+  for (int k = 0; k < kSteps; ++k) {
+    for (int e = 0; e < n; ++e) raw[static_cast<std::size_t>(k)].col(e) = intent(k + e);
+    env.step(raw[static_cast<std::size_t>(k)], {}, {}, exec);
+    for (int e = 0; e < n; ++e) obs[static_cast<std::size_t>(k)].col(e) = kModel.expected(exec.col(e));
+  }
+  int k = 0;
+  for (auto _ : state) {
+    b.update(raw[static_cast<std::size_t>(k)], obs[static_cast<std::size_t>(k)]);
+    if (++k == kSteps) {
+      k = 0;
+      b.reset();
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * n);  // environment steps
+  state.SetLabel(std::to_string(b.size()) + " hypotheses x " + std::to_string(n) + " envs");
+}
+BENCHMARK(BM_BatchedBeliefUpdate)
+    ->ArgsProduct({{0, 1}, {1, 8, 1024}})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

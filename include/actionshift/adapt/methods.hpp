@@ -11,6 +11,7 @@
 
 #include "actionshift/adapt/adapter.hpp"
 #include "actionshift/adapt/pool_belief.hpp"
+#include "actionshift/adapt/probe_selector.hpp"
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/rng.hpp"
@@ -69,6 +70,9 @@ struct ProbeOptions {
 std::vector<double> expected_response_magnitude(const PoolBelief& belief, const std::vector<Action>& candidates,
                                                 const Mat3& R, const ProbeOptions& o);
 
+/// Number of probe candidates: ± one pose channel at a time.
+inline constexpr std::size_t kNumCandidates = 2 * kPoseDim;
+
 /// The 12 probe candidates in the reference's order: +a·e0 … +a·e5, −a·e0 … −a·e5 (gripper 0).
 std::vector<Action> probe_candidates(double amplitude);
 /// The fixed pulse sequence: amplitude·(±1) on channel step % 6, + for (step / 6) even.
@@ -114,6 +118,7 @@ class ProbingAdapter final : public Adapter {
   PoolBelief belief_;
   ProbeStrategy strategy_;
   ProbeOptions options_;
+  ProbeSelector selector_;  // the selection's workspace, sized once
   std::vector<Action> candidates_;
   Rng rng_;
   int steps_{0};
@@ -150,6 +155,7 @@ class DualAbiAdapter final : public Adapter {
   double threshold_;
   ProbeOptions options_;
   int window_;
+  ProbeSelector selector_;  // the selection's workspace, sized once
   std::vector<Action> candidates_;
   std::vector<Action> recent_;  // newest first
   bool fresh_{true};

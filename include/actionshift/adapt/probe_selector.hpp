@@ -1,0 +1,98 @@
+#pragma once
+/// \file The allocation-free workspace behind entropy probing and DualABI (methods.hpp).
+///
+/// A selection scores every probe candidate by simulating, for each active hypothesis h, the
+/// observation h predicts and the posterior the belief would move to. The work shared across
+/// candidates and hypotheses is done once:
+/// - the active set (largest mass first) and its probabilities, once per step;
+/// - per candidate, each active hypothesis' prediction once, scaled by α/σ, so that the squared
+///   Mahalanobis distance between two hypotheses' observations is one symmetric n × n matrix
+///   (the log-likelihood of "h observed, j explains it" is −½ D(j, h));
+/// - all n posteriors of a candidate as one n × n array (one vectorised exp over it);
+/// - DualABI's pairwise task error E once per step, with each hypothesis' encoding of the recent
+///   window computed once and the other hypotheses' decoding done on the whole window at a time
+///   (the tool-frame rotation is moved to the intents' side, where ‖R v‖ = ‖v‖ removes it).
+/// Every buffer is sized at construction for the pool and `max_active`; a selection allocates
+/// nothing.
+
+#include "actionshift/adapt/pool_belief.hpp"
+#include "actionshift/core/types.hpp"
+
+#include <Eigen/Core>
+
+#include <span>
+#include <vector>
+
+namespace actionshift::adapt {
+
+/// The active set of a belief with probabilities `p`: the largest-mass hypotheses (ties by index)
+/// until `mass` is covered or `max_active` are taken, written to `out` in increasing index order;
+/// returns how many. `order` is scratch of p.size(); `out` holds min(max(1, max_active), p.size()).
+int active_set(const Eigen::Ref<const Eigen::VectorXd>& p, int max_active, double mass, std::span<int> order,
+               std::span<int> out);
+
+class ProbeSelector {
+ public:
+  /// `pool_size` hypotheses, at most `max_active` of them active, a DualABI window of `window`
+  /// intents (0 if task errors are never computed). Throws std::invalid_argument on sizes < 1.
+  ProbeSelector(int pool_size, int max_active, int window = 0);
+
+  /// The active set of `b` (active_hypotheses() of methods.hpp), its probabilities and mass.
+  void select_active(const PoolBelief& b, int max_active, double mass);
+  /// An explicit active set (indices into the pool, each once).
+  void set_active(const PoolBelief& b, std::span<const int> active);
+
+  int num_active() const noexcept { return n_; }
+  std::span<const int> active() const noexcept { return {active_.data(), static_cast<std::size_t>(n_)}; }
+  /// Σ p over the active hypotheses, summed in increasing index order.
+  double active_mass() const noexcept { return mass_; }
+
+  /// Expected posterior entropy of observing the response to `candidate` (weights p_h / mass) and,
+  /// if `motion` is non-null, the belief-weighted expected response magnitude Σ p_h/mass ‖α ⊙ pred_h‖.
+  double expected_entropy(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
+                          bool lag_aware, double* motion = nullptr);
+
+  /// DualABI: the pairwise task error E(i, j) over the active set for the window `recent`
+  /// (‖decode_j(encode_i(a)) − a‖ averaged over the window, 0 on the diagonal).
+  void compute_task_error(const PoolBelief& b, std::span<const Action> recent, const Mat3& R);
+  /// Load an explicit task-error matrix (n × n over the active set).
+  void set_task_error(const Eigen::MatrixXd& E);
+  /// Copy of the current task-error matrix.
+  Eigen::MatrixXd task_error() const;
+  /// Regret of acting on the MAP of the active set's normalised probabilities.
+  double current_regret();
+  /// Expected regret after observing the response to `candidate` (weights p_h / Σ p).
+  double expected_future_regret(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
+                                bool lag_aware);
+
+ private:
+  using Cols6 = Eigen::Matrix<double, Eigen::Dynamic, kPoseDim>;
+  // predictions of the active hypotheses for one candidate: S = α/σ ⊙ pred (model side), O = the
+  // simulated observation / σ (equal to S under the calibrated preview); A = α ⊙ pred for motion
+  void predict(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated, bool lag_aware, bool motion);
+  // the n × n log-posterior numerators, exponentiated column by column (column h: h observed)
+  void posteriors(bool calibrated);
+  // regret of acting on the MAP of the posterior in column h of ex_ (normalised by sums_[h])
+  double regret_of_column(int h);
+
+  int pool_size_, max_active_, window_;
+  int n_{0};
+  double mass_{0};
+  std::vector<int> order_;   // pool_size, scratch for the active set
+  std::vector<int> active_;  // max_active
+  Eigen::VectorXd p_all_;    // pool_size
+  Eigen::VectorXd p_;        // active probabilities
+  Eigen::VectorXd logp_;     // active log-probabilities
+  Cols6 S_, O_;
+  Eigen::VectorXd motion_;   // ‖α ⊙ pred‖ per active hypothesis
+  std::vector<double> buf_;  // n × n work array (x − max, then exp), contiguous
+  Eigen::VectorXd max_, sums_, weighted_;  // per column of the work array
+  Eigen::VectorXd post_;
+  // DualABI
+  Eigen::MatrixXd Et_;  // transposed task error: Et_(j, i) = E(i, j), so a row of E is a column
+  Eigen::Matrix<double, kPoseDim, Eigen::Dynamic, Eigen::RowMajor> raw_;  // one hypothesis' encoded window
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Y_;  // 6·n × window targets
+  Eigen::Array<double, 1, Eigen::Dynamic> acc_;  // window
+};
+
+}  // namespace actionshift::adapt
