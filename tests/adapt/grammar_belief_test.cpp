@@ -22,7 +22,7 @@ using actionshift::testing::intent;
 using actionshift::testing::pick_like;
 using actionshift::reference::representative_contracts;
 
-// ---- privilege: the grammar and the calibration only (reference §15 item 23)
+// ---- privilege: the grammar and the calibration only (the reference implementation's privilege invariant)
 
 static_assert(std::is_constructible_v<GrammarBeliefAdapter, ResponseModel, GrammarOptions>);
 static_assert(std::is_constructible_v<GrammarBelief, ResponseModel>);
@@ -141,7 +141,7 @@ TEST(GrammarBelief, ReachesParityOnDeltaAndAbsolute) {
 }
 
 TEST(GrammarBelief, IdentifiesRandomFullGrammarContractsWithNoise) {
-  // reference §15 item 26: random delta and absolute contracts (lags on the grid) within 48 steps
+  // the reference implementation's identification invariant: random delta and absolute contracts (lags on the grid) within 48 steps
   const ResponseModel m = unit_model();
   Rng rng(20260718);
   grammar::SamplerSpec spec;
@@ -286,10 +286,10 @@ TEST(GrammarParams, DefaultsAndMalformed) {
 }
 
 
-// ---- the finger channel (reference §4.5)
+// ---- the finger channel (the public reference implementation's finger channel, docs/reference.md)
 
 TEST(GrammarGripper, FingerChannelIdentifiesInversion) {
-  // reference §15 item 29: α_g 0.05, σ_g 0.01, inversion true and false identified after 32 steps
+  // the reference implementation's finger-channel invariant: α_g 0.05, σ_g 0.01, inversion true and false identified after 32 steps
   ResponseModel m = unit_model();
   m.gripper_alpha = 0.05;
   m.gripper_sigma = 0.01;

@@ -31,7 +31,7 @@ def run_episode(env, adapter, seed, steps, intent):
 def test_every_registered_method_builds_and_runs():
     names = actionshift.methods()
     assert set(names) == {"oracle", "no_adapt", "exact_belief", "fixed_probes", "random_probes",
-                          "entropy_probes", "dualabi"}
+                          "entropy_probes", "dualabi", "grammar_belief"}
     truth = actionshift.load_manifest("reference9").contracts[1]
     env = actionshift.make(TASK, contract=truth)
     intent = np.array([0.2, 0.0, -0.1, 0.0, 0.0, 0.0, 1.0])
@@ -42,7 +42,7 @@ def test_every_registered_method_builds_and_runs():
         expected_probes = {"fixed_probes": 6, "random_probes": 6, "entropy_probes": 6}.get(method)
         if expected_probes is not None:
             assert probes == expected_probes, method
-        elif method in ("oracle", "no_adapt", "exact_belief"):
+        elif method in ("oracle", "no_adapt", "exact_belief", "grammar_belief"):
             assert probes == 0, method
 
 

@@ -27,7 +27,7 @@ struct LinearFit {
 /// (reference `fit_linear_response`). Throws std::invalid_argument if sizes differ or are empty.
 LinearFit fit_linear_response(const std::vector<Pose6>& commanded, const std::vector<Pose6>& observed);
 
-/// The finger channel's fit (reference §4.5): command = the gripper action, observed = the change
+/// The finger channel's fit (the public reference implementation's finger channel, docs/reference.md): command = the gripper action, observed = the change
 /// of the mean finger position (m) over the step.
 struct GripperFit {
   int start{-1};        ///< offset of the two finger joint positions in the observation

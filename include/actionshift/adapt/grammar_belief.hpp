@@ -10,7 +10,7 @@
 /// to output channels (a permutation), then the mode with the largest total. Frame is collapsed to
 /// base (a tool contract cannot be represented under live rotation). The gripper inversion is an
 /// independent binary factor scored on the finger channel when the calibration has one
-/// (reference §4.5); without it the gripper is reported not inverted (unobservable).
+/// (the public reference implementation's finger channel, docs/reference.md); without it the gripper is reported not inverted (unobservable).
 ///
 /// Hold-probe excitation: during a hold window the per-step evidence is replaced by one term on
 /// the window's summed response, with σ·sqrt(len): an absolute drive telescopes over the hold

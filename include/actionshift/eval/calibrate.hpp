@@ -32,7 +32,7 @@ struct CalibrationOptions {
   int episodes{8};                  ///< random walks (reference: 8 environments) or episodes
   int steps{64};                    ///< control steps per walk (reference: 64) or per episode
   std::uint64_t seed{20260720};     ///< the reference's calibration seed
-  /// Also fit the finger channel (reference §4.5): gripper action vs the change of the mean of the
+  /// Also fit the finger channel (the public reference implementation's finger channel, docs/reference.md): gripper action vs the change of the mean of the
   /// two finger joint positions (qpos[7:9]) over each step. Adds the optional "gripper" key.
   bool gripper_channel{false};
 };
