@@ -1,5 +1,6 @@
 // SVG figures of results: grouped bars with Wilson intervals, probe-cost scatter with its Pareto front
 #include "actionshift/render/figures.hpp"
+#include "xml_escape.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -34,19 +35,7 @@ bool method_less(const std::string& a, const std::string& b) {
 
 bool is_long_lag(const std::string& split) { return split.find("long_lag") != std::string::npos; }
 
-std::string esc(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string esc(const std::string& s) { return detail::xml_escape(s); }
 
 std::string num(double x) {
   char b[32];

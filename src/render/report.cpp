@@ -1,5 +1,6 @@
 // the results report: HTML + Markdown with tables, verdicts, figures and provenance
 #include "actionshift/render/report.hpp"
+#include "xml_escape.hpp"
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/eval/summary.hpp"
@@ -21,19 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string esc(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string esc(const std::string& s) { return detail::xml_escape(s); }
 
 std::string md(const std::string& s) {  // a Markdown table cell
   std::string out;
