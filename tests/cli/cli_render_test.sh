@@ -70,12 +70,49 @@ done < <(grep -o -E '(src|href)="[^"]+"' "$TMP/report/index.html" | sed -E 's/^(
 run "$AS" report "$TMP/nowhere" --out "$TMP/report2"
 expect_rc 2 "report of a missing directory"; expect_one_line_error "report of a missing directory"
 
-# the page in a real headless browser, when Debian's chromium is installed
+# the page in a real headless browser, when Debian's chromium is installed (scripts/setup installs it):
+# a copy of the page with a checker script appended loads every image and every local link and
+# writes its verdict into the DOM, which chromium dumps after the load event
+browser_check() {  # browser_check PAGE -> sets $verdict
+  python3 - "$1" "$1.check.html" <<'PY'
+import sys
+page = open(sys.argv[1]).read()
+checker = """<script>
+window.addEventListener('load', () => {
+  const bad = [];
+  for (const i of document.images)
+    if (!(i.complete && i.naturalWidth > 0)) bad.push('image:' + i.getAttribute('src'));
+  for (const a of document.querySelectorAll('a[href]')) {
+    const h = a.getAttribute('href');
+    if (h.startsWith('#')) { if (!document.getElementById(h.slice(1))) bad.push('anchor:' + h); continue; }
+    if (/^[a-z]+:/i.test(h)) continue;
+    try { const x = new XMLHttpRequest(); x.open('GET', h, false); x.send(); }
+    catch (e) { bad.push('link:' + h); }
+  }
+  document.body.setAttribute('data-check',
+      bad.length ? 'BROKEN ' + bad.join(' ') : 'OK images=' + document.images.length);
+});
+</script>"""
+assert '</body>' in page, 'no </body> in ' + sys.argv[1]
+open(sys.argv[2], 'w').write(page.replace('</body>', checker + '</body>'))
+PY
+  run timeout 120 /usr/bin/chromium --headless --no-sandbox --disable-gpu --allow-file-access-from-files \
+    --virtual-time-budget=10000 --dump-dom "file://$1.check.html"
+  verdict=$(printf '%s' "$OUT" | grep -o 'data-check="[^"]*"' || true)
+  rm -f "$1.check.html"
+}
 if [ -x /usr/bin/chromium ]; then
-  run timeout 120 /usr/bin/chromium --headless --no-sandbox --disable-gpu --screenshot="$TMP/shot.png" \
-    --window-size=1200,2000 "file://$TMP/report/index.html"
-  [ -s "$TMP/shot.png" ] && ok || bad "chromium did not render the page: $ERR"
+  browser_check "$TMP/report/index.html"
+  case "$verdict" in
+    'data-check="OK images='*) [ "${verdict//[!0-9]/}" -ge 1 ] && ok || bad "chromium saw no image: $verdict" ;;
+    *) bad "chromium: the report page is broken: ${verdict:-no verdict (the page did not load)}" ;;
+  esac
+  # the check can fail: a page whose figure is missing is caught
+  sed 's#figures/gate1.svg#figures/absent.svg#g' "$TMP/report/index.html" > "$TMP/report/broken.html"
+  browser_check "$TMP/report/broken.html"
+  case "$verdict" in *"image:figures/absent.svg"*"link:figures/absent.svg"*) ok ;; *) bad "chromium check missed a missing image and link: $verdict" ;; esac
+  rm -f "$TMP/report/broken.html"
 else
-  echo "note: /usr/bin/chromium absent: the headless-browser check is skipped (apt-get install chromium to run it)"
+  echo "note: /usr/bin/chromium absent: the headless-browser check is skipped (scripts/setup installs chromium)"
 fi
 finish
