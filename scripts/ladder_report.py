@@ -246,6 +246,70 @@ for t in TASKS:
           f"{f3(ex['p'])} | {f3(orc['p'])} |")
 w("")
 
+# the generated unseen_composition split, by contract class (gripper not inverted = the pose fields decide)
+manifest = json.load(open(os.path.join(ROOT, "manifests", "unseen_composition.json")))
+klass = [(e["contract"]["frame"], e["contract"]["target"], e["contract"]["gripper_inverted"]) for e in manifest["test"]]
+GEN = {}
+for name in ("gen_fixed", "gen_hold", "gen_hold_identity"):
+    specs.update(load_specs(name))
+    for r in load(name):
+        GEN.setdefault((name, r["task"]), {})[(r["seed"], r["contract_index"], r["episode_index"])] = r
+
+
+def gen_subset(name, task, frame=None, target=None, inverted=None):
+    out = {}
+    for k, r in GEN.get((name, task), {}).items():
+        f, t, g = klass[k[1]]
+        if (frame is None or f == frame) and (target is None or t == target) and (inverted is None or g == inverted):
+            out[k] = r
+    return out
+
+
+def rate_str(d):
+    n = len(d)
+    if n == 0:
+        return "—"
+    k = sum(1 for r in d.values() if r["success_once"])
+    lo, hi = wilson(k, n)
+    return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] (n={n})"
+
+
+GEN_ROWS = [("fixed pulses, live", "gen_fixed"), ("hold h2-r1, live", "gen_hold"), ("hold h2-r1, identity rotation", "gen_hold_identity")]
+CLASSES = [(f, t, g) for g in (False, True) for f in ("base", "tool") for t in ("delta", "absolute")]
+gen_have = any(GEN.values())
+if gen_have:
+    w("## The generated all-absolute-heavy split, by contract class")
+    w("")
+    w("Both all-absolute reference contracts invert the gripper, so without the finger channel the reference cells above")
+    w("cannot show what the pose fields alone allow. The generated `unseen_composition` split (32 contracts, 3 episodes per")
+    w("contract and seed, three seeds) has 13 contracts whose gripper is not inverted; there the grammar belief's pose fields")
+    w("decide. Rows: the grammar belief with 6 fixed pulses and with the hold probe under live rotation, and the hold probe")
+    w("with the frame rotation held at the identity (where tool = base).")
+    w("")
+    cls_count = {c: sum(1 for k in klass if k == c) for c in CLASSES}
+    w("| contracts (frame, target, gripper) | # | " + " | ".join(f"{TASK_LABEL[t]}: {label}" for t in TASKS for label, _ in GEN_ROWS) + " |")
+    w("|---|---:|" + "---:|" * (len(TASKS) * len(GEN_ROWS)))
+    for f, t_, g in CLASSES:
+        vals = [rate_str(gen_subset(name, t, f, t_, g)) for t in TASKS for _, name in GEN_ROWS]
+        w(f"| {f}, {t_}, {'inverted' if g else 'not inverted'} | {cls_count[(f, t_, g)]} | " + " | ".join(vals) + " |")
+    w("")
+    w("Paired differences on the contracts with the gripper not inverted:")
+    w("")
+    w("| difference | " + " | ".join(TASK_LABEL[t] for t in TASKS) + " |")
+    w("|---|---|---|")
+    GD = {}
+    for label, a, b, sel in [("hold − fixed, absolute targets (base and tool), live", "gen_hold", "gen_fixed", dict(target="absolute", inverted=False)),
+                             ("hold − fixed, absolute targets, base frame, live", "gen_hold", "gen_fixed", dict(frame="base", target="absolute", inverted=False)),
+                             ("hold identity − hold live, tool frame", "gen_hold_identity", "gen_hold", dict(frame="tool", inverted=False)),
+                             ("hold identity − hold live, base frame (control)", "gen_hold_identity", "gen_hold", dict(frame="base", inverted=False))]:
+        row = []
+        for t in TASKS:
+            d = paired(gen_subset(a, t, **sel), gen_subset(b, t, **sel))
+            GD[(a, b, label, t)] = d
+            row.append(fmt_diff(d))
+        w(f"| {label} | " + " | ".join(row) + " |")
+    w("")
+
 # paired differences
 PAIRS = [
     ("passive", "no_adapt", "grammar knowledge over no adaptation"),
@@ -328,6 +392,15 @@ tool_live_worse = all(pd is not None and pd["lo"] > 0 for (t, c, lr, ir, pd) in 
 F.append(("The factorized belief cannot represent tool frame under live rotation",
           "on contract 0 (tool) of the all-absolute split, grammar hold with identity rotation − with live rotation > 0 on both tasks",
           tool_live_worse, any(pd is None for (_, c, _, _, pd) in tool_rows if c == 0)))
+if gen_have:
+    ga = [GD.get(("gen_hold", "gen_fixed", "hold − fixed, absolute targets (base and tool), live", t)) for t in TASKS]
+    gt = [GD.get(("gen_hold_identity", "gen_hold", "hold identity − hold live, tool frame", t)) for t in TASKS]
+    F.append(("(generated split) Hold-probe excitation breaches the all-absolute wall where the gripper is not inverted",
+              "hold − fixed > 0 on the absolute, gripper-not-inverted contracts of the generated unseen_composition split, both tasks",
+              all(sig_pos(d) for d in ga), any(d is None for d in ga)))
+    F.append(("(generated split) The factorized belief cannot represent tool frame under live rotation",
+              "hold with identity rotation − with live rotation > 0 on the tool-frame, gripper-not-inverted contracts, both tasks",
+              all(sig_pos(d) for d in gt), any(d is None for d in gt)))
 w("## Which of the paper's findings reproduce")
 w("")
 w("Rule (fixed in this script, applied to the numbers above): a finding about a difference is reproduced when our paired")
@@ -338,5 +411,25 @@ w("| paper's finding | our test | verdict |")
 w("|---|---|---|")
 for claim, test, ok, untestable in F:
     w(f"| {claim} | {test} | {verdict(ok, untestable)} |")
+w("")
+# the differences from the paper, explained with the numbers above
+c1p = cell("passive", "pick_cube", seen, 1)
+c0p = cell("passive", "pick_cube", seen, 0)
+w("## Differences from the paper, explained")
+w("")
+w(f"- **The grammar rung sits at one half on the seen cells**: per contract, the passive grammar belief reaches"
+  f" {f3(c1p['p'])} on Pick/seen c1 (gripper not inverted) and {f3(c0p['p'])} on c0 (gripper inverted); probing cannot help c0."
+  " The paper's v1 per-flag numbers show the same wall (Pick/seen passive 0.723 / 0.003, probes 0.917 / 0.000); our"
+  " not-inverted cell is higher because this simulator's response is far more informative per step (α/σ of 3-5 on the"
+  " translation channels against about 1 in the paper's ManiSkill runs, docs/sim.md §0), so the pose fields are"
+  " identified within the first steps with or without pulses. For the same reason fixed pulses, entropy pulses and the"
+  " hold probe cannot improve on passive here: there is nothing left to identify on the not-inverted contract.")
+w("- **The all-absolute reference cells stay at the floor for every grammar variant**, because both of their contracts"
+  " invert the gripper and our committed calibrations have no finger channel (`calibrate --gripper-channel` exists; the"
+  " committed calibrations were not regenerated, since their hashes name every belief job of the tournament). The paper's"
+  " hold-probe numbers on those cells (0.722 / 0.790) were measured with the finger channel (v2) and the corrector. The"
+  " generated split's not-inverted contracts are the test of the pose-field claims here.")
+w("- **The pool rung is at the ceiling** on the reference splits (0.997-1.000 against the paper's 0.929-0.995): nine"
+  " hypotheses are separated within the first steps by the same informative response (see docs/results/tournament.md).")
 w("")
 print("\n".join(out))

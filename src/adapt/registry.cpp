@@ -143,6 +143,7 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
       sc.min_correction = p.at("scale_min").get<double>();
       sc.max_correction = p.at("scale_max").get<double>();
       sc.command_floor = p.at("scale_floor").get<double>();
+      sc.fit = in.gain_fit;
       o.scale = sc;
     }
     o.reanchor_period = p.at("reanchor_period").get<int>();

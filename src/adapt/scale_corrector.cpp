@@ -87,8 +87,8 @@ void ScaleCorrector::commit() {
     double sum = 0.0;
     for (double x : cmd) sum += x;
     if (!(sum > options_.command_floor)) continue;
-    estimate_[c] = fit_window_gain(cmd, obs, alpha_[static_cast<std::size_t>(c)], eff_window_[c], options_.min_correction,
-                                   options_.max_correction);
+    const GainFit fit = options_.fit ? options_.fit : &fit_window_gain_closed_form;
+    estimate_[c] = fit(cmd, obs, alpha_[static_cast<std::size_t>(c)], eff_window_[c], options_.min_correction, options_.max_correction);
     valid_[static_cast<std::size_t>(c)] = true;
     ++fits_;
   }

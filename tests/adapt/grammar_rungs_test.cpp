@@ -115,6 +115,43 @@ TEST(ScaleCorrector, CommitsAfterAWindowOfActiveStepsAboveTheFloor) {
   EXPECT_EQ(sc.estimate(), Pose6::Ones());
 }
 
+int counted_fits = 0;
+double counting_fit(std::span<const double> c, std::span<const double> o, double a, double g, double lo, double hi) {
+  ++counted_fits;
+  return fit_window_gain(c, o, a, g, lo, hi);
+}
+
+TEST(ScaleCorrector, TheCeresFitAndTheClosedFormCorrectAlike) {
+  // the runner passes the Ceres fit (MethodInputs::gain_fit); without it the closed form is used
+  const ResponseModel m = pick_like();
+  ContractFields f = representative_contracts("seen")[1].fields();
+  for (auto& s : f.scale) s = 1.1;
+  const Contract truth = Contract::make(f);
+  MethodInputs in;
+  in.model = &m;
+  in.gain_fit = &counting_fit;
+  const auto p = resolve_method_params("grammar_belief", {{"scale_correction", true}, {"scale_window", 8}, {"scale_floor", 0.02}});
+  auto with_ceres = make_adapter("grammar_belief", p, in);
+  in.gain_fit = nullptr;
+  auto closed = make_adapter("grammar_belief", p, in);
+  counted_fits = 0;
+  for (auto* a : {with_ceres.get(), closed.get()}) {
+    Decoder env(truth);
+    a->begin_episode(0);
+    for (int k = 0; k < 40; ++k) {
+      const Action raw = a->encode(intent(k), Mat3::Identity());
+      a->observe(raw, m.expected(env.step(raw, Mat3::Identity())), Mat3::Identity());
+    }
+  }
+  EXPECT_GT(counted_fits, 0);  // only the first adapter fitted through the injected function
+  const auto& e1 = dynamic_cast<GrammarBeliefAdapter*>(with_ceres.get())->belief().corrector()->estimate();
+  const auto& e2 = dynamic_cast<GrammarBeliefAdapter*>(closed.get())->belief().corrector()->estimate();
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_NEAR(e1[c], e2[c], 1e-7) << c;
+    EXPECT_NEAR(e1[c], 1.1, 1e-6) << c;
+  }
+}
+
 TEST(ScaleCorrector, AChangedEncodingScaleDiscardsTheOpenWindow) {
   ScaleCorrector sc(pick_like().alpha, {4, 0.4, 2.5, 0.0});
   const Pose6 cmd = Pose6::Constant(0.5);
@@ -272,7 +309,9 @@ TEST(GrammarEntropyProbe, ChoosesThePulseThatMaximisesTheStatedCriterion) {
         }
       }
       EXPECT_NEAR(criterion(b, GrammarBelief::probe_candidate(q, 0.5), hist), best, 1e-9 * std::max(1.0, best)) << step;
-      if (step == 0) EXPECT_EQ(q, arg);  // the fresh belief: every pulse ties, the first wins
+      if (step == 0) {
+        EXPECT_EQ(q, arg);  // the fresh belief: every pulse ties, the first wins
+      }
       const Action raw = GrammarBelief::probe_candidate(q, 0.5);
       EXPECT_LE(raw.head<6>().cwiseAbs().maxCoeff(), 0.5);
       EXPECT_EQ(raw[6], 0.0);  // the gripper is never actuated

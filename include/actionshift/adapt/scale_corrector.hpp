@@ -7,7 +7,7 @@
 /// canonical pose the adapter commanded, the scale it encoded with and the observed response.
 ///
 /// Each window of `window` active steps with an unchanged effective scale ends in a least-squares
-/// fit per channel (done by Ceres, `fit_window_gain`): the cumulative observed magnitude
+/// fit per channel (done by Ceres, `fit_window_gain`, in the runs; the closed form otherwise): the cumulative observed magnitude
 /// O_t = Σ_{u≤t} |obs_u| against the cumulative commanded magnitude C_t = Σ_{u≤t} |cmd_u|,
 ///   minimise Σ_t (O_t − |α|·(g / g_w)·C_t)²  over g ∈ [min_correction, max_correction],
 /// where g_w is the scale the window encoded with (an encode with scale g_w executes g_true/g_w of
@@ -25,17 +25,26 @@
 
 namespace actionshift::adapt {
 
+/// A window fit: (|command| per step, |response| per step, α, the window's encoding scale, lower bound,
+/// upper bound) → the gain estimate. `fit_window_gain` (Ceres, library ActionShift::fit) or
+/// `fit_window_gain_closed_form` (this library).
+using GainFit = double (*)(std::span<const double>, std::span<const double>, double, double, double, double);
+
 struct ScaleCorrectorOptions {
   int window{16};               ///< active steps per fit (the reference's default), in [1, 1000]
   double min_correction{0.4};   ///< lower bound of the estimate, in (0, 1]
   double max_correction{2.5};   ///< upper bound, ≥ 1
   double command_floor{0.05};   ///< minimum C_T (summed |command| over the window) to commit a channel, ≥ 0
+  /// The fit; null: the closed form. The runner (ActionShift::eval) passes the Ceres fit, so that
+  /// ActionShift::adapt itself (and the self-test that links it) does not depend on Ceres.
+  GainFit fit{nullptr};
 
   /// Throws std::invalid_argument unless 0 < min ≤ 1 ≤ max (finite), floor finite ≥ 0, window in [1, 1000].
   void validate() const;
 };
 
-/// The window's least-squares fit of one channel (Ceres; the only translation unit that includes it):
+/// The window's least-squares fit of one channel by Ceres (defined in library ActionShift::fit,
+/// src/adapt/scale_fit.cpp, the only translation unit that includes Ceres):
 /// minimises Σ_t (O_t − |alpha|·(g/eff_window)·C_t)² with C, O the cumulative sums of `abs_cmd` and
 /// `abs_obs`, g bounded to [lo, hi], starting from g = eff_window clamped to the bounds.
 /// Requires equal lengths, at least one step and finite inputs (else std::invalid_argument).
