@@ -30,7 +30,7 @@ seeds = sorted({s["seed"] for s in specs})
 commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
 total = sum(c["episodes"] for c in cells)
 
-methods = ["oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes", "exact_belief", "no_adapt"]
+methods = ["oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes", "exact_belief", "grammar_belief", "no_adapt"]
 tasks = ["pick_cube", "push_cube", "pull_cube", "stack_cube"]
 ref_splits = ["reference_seen", "reference_unseen_composition", "reference_long_lag"]
 gen_splits = ["seen", "unseen_composition", "long_lag"]
@@ -117,7 +117,7 @@ print("|---|---|---|---|")
 for split in ref_splits + gen_splits:
     best = None
     for task in tasks:
-        rates = [by[(task, split, m)]["success_once"]["rate"] for m in methods if m not in ("oracle", "no_adapt") and (task, split, m) in by]
+        rates = [by[(task, split, m)]["success_once"]["rate"] for m in methods if m not in ("oracle", "no_adapt", "grammar_belief") and (task, split, m) in by]
         if rates and (best is None or max(rates) - min(rates) > best[0]):
             best = (max(rates) - min(rates), task)
     d = diff("entropy_probes", "exact_belief", "pick_cube", split)
@@ -212,7 +212,7 @@ for split in ref_splits + gen_splits:
     print()
     # spread of the belief family, per task
     for task in tasks:
-        rates = [(m, by[(task, split, m)]["success_once"]["rate"]) for m in methods if m not in ("oracle", "no_adapt") and (task, split, m) in by]
+        rates = [(m, by[(task, split, m)]["success_once"]["rate"]) for m in methods if m not in ("oracle", "no_adapt", "grammar_belief") and (task, split, m) in by]
         if rates:
             lo = min(rates, key=lambda x: x[1]); hi = max(rates, key=lambda x: x[1])
             if hi[1] - lo[1] < 1e-12:

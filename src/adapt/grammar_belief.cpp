@@ -4,6 +4,7 @@
 #include "actionshift/core/grammar.hpp"
 #include "actionshift/core/transforms.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -48,8 +49,11 @@ const std::array<GrammarBelief::Mode, GrammarBelief::kModes>& GrammarBelief::mod
   return m;
 }
 
-GrammarBelief::GrammarBelief(const ResponseModel& model) : model_(model) {
+GrammarBelief::GrammarBelief(const ResponseModel& model, std::optional<ScaleCorrectorOptions> scale, int reanchor_period)
+    : model_(model), reanchor_period_(reanchor_period) {
   model_.validate();
+  if (reanchor_period < 0) throw std::invalid_argument("reanchor_period must be nonnegative");
+  if (scale) corrector_.emplace(model_.alpha, *scale);
   for (int s = 0; s < kSigns; ++s)
     for (int k = 0; k < kScales; ++k)
       coef_[static_cast<std::size_t>(s * kScales + k)] = (s == 0 ? -1.0 : 1.0) * grammar::kScaleGrid[static_cast<std::size_t>(k)];
@@ -65,6 +69,11 @@ void GrammarBelief::reset() {
   hold_obs_.setZero();
   hold_len_ = 0;
   gscore_ = {0.0, 0.0};
+  if (corrector_) corrector_->reset();
+  have_command_ = false;
+  last_command_.setZero();
+  last_eff_scale_.setOnes();
+  steps_since_reset_ = 0;
   map_valid_ = false;
 }
 
@@ -103,10 +112,16 @@ void GrammarBelief::add_cells(const Pose6& obs, const std::array<Pose6, kModes>&
     }
 }
 
-void GrammarBelief::update(const Action& raw, const Pose6& observed, bool hold, bool window_close) {
+void GrammarBelief::update(const Action& raw, const Pose6& observed, bool hold, bool window_close, bool corrector_active) {
   for (int d = kHistory - 1; d > 0; --d) history_[static_cast<std::size_t>(d)] = history_[static_cast<std::size_t>(d - 1)];
   history_[0] = raw.head<kPoseDim>();
+  // the scale corrector learns from the previous map_encode's command, before scoring (reference order)
+  if (corrector_ && have_command_) corrector_->accumulate(last_command_, observed, last_eff_scale_, corrector_active);
+  have_command_ = false;
   observed_cumulative_ += observed;
+  ++steps_since_reset_;
+  if (reanchor_period_ > 0 && steps_since_reset_ % reanchor_period_ == 0)
+    target_.head<3>() = observed_cumulative_.head<3>();  // rotation channels keep the cumulative intent
   std::array<Pose6, kModes> base;
   for (int m = 0; m < kModes; ++m)
     for (int j = 0; j < kPoseDim; ++j) base[static_cast<std::size_t>(m)][j] = drive(m, j);
@@ -201,15 +216,104 @@ const GrammarBelief::Map& GrammarBelief::map() const {
 }
 
 Action GrammarBelief::map_encode(const Action& canonical, bool accumulate) {
-  const Action raw = actionshift::encode(map().contract, canonical, Mat3::Identity(), target_);
+  Action raw;
+  if (corrector_) {  // encode with the corrected scale and remember the command for the next update
+    const Contract& c = map().contract;
+    Pose6 base;
+    for (int i = 0; i < kPoseDim; ++i) base[i] = c.scale()[static_cast<std::size_t>(i)];
+    last_eff_scale_ = corrector_->effective_scale(base);
+    last_command_ = canonical.head<kPoseDim>();
+    have_command_ = true;
+    if (last_eff_scale_ == base) {
+      raw = actionshift::encode(c, canonical, Mat3::Identity(), target_);
+    } else {
+      ContractFields f = c.fields();
+      for (int i = 0; i < kPoseDim; ++i) f.scale[static_cast<std::size_t>(i)] = last_eff_scale_[i];
+      raw = actionshift::encode(Contract::make(f), canonical, Mat3::Identity(), target_);
+    }
+  } else {
+    raw = actionshift::encode(map().contract, canonical, Mat3::Identity(), target_);
+  }
   if (accumulate) target_ += canonical.head<kPoseDim>();
   return raw;
+}
+
+Action GrammarBelief::probe_candidate(int index, double amplitude) {
+  Action a = Action::Zero();
+  a[index % kPoseDim] = index < kPoseDim ? amplitude : -amplitude;
+  return a;
+}
+
+int GrammarBelief::select_entropy_probe(double amplitude) const {
+  constexpr int kSK = kSigns * kScales;
+  // per output channel i: the cell posterior's first two moments of sign·scale per (m, j)
+  std::array<double, static_cast<std::size_t>(kPoseDim * kModes * kPoseDim)> w1{}, w2{};
+  for (int i = 0; i < kPoseDim; ++i) {
+    double top = -std::numeric_limits<double>::infinity();
+    for (int m = 0; m < kModes; ++m) {
+      const double* cell = &S_[index(m, i, 0, 0, 0)];
+      for (int x = 0; x < kPoseDim * kSK; ++x) top = std::max(top, cell[x]);
+    }
+    double z = 0.0;
+    for (int m = 0; m < kModes; ++m)
+      for (int j = 0; j < kPoseDim; ++j) {
+        const double* cell = &S_[index(m, i, j, 0, 0)];
+        double a1 = 0.0, a2 = 0.0;
+        for (int sk = 0; sk < kSK; ++sk) {
+          const double w = std::exp(cell[sk] - top);
+          const double c = coef_[static_cast<std::size_t>(sk)];
+          z += w;
+          a1 += w * c;
+          a2 += w * c * c;
+        }
+        const auto at = static_cast<std::size_t>((i * kModes + m) * kPoseDim + j);
+        w1[at] = a1;
+        w2[at] = a2;
+      }
+    for (std::size_t at = static_cast<std::size_t>(i * kModes * kPoseDim); at < static_cast<std::size_t>((i + 1) * kModes * kPoseDim); ++at) {
+      w1[at] /= z;
+      w2[at] /= z;
+    }
+  }
+  // the drive of every mode and raw channel if `pulse` were sent now: the history shifted by one
+  auto drive_with = [&](int m, int j, double pulse_j) {
+    const Mode& mode = modes()[static_cast<std::size_t>(m)];
+    const auto lag = static_cast<std::size_t>(mode.lag);
+    const double x = lag == 0 ? pulse_j : history_[lag - 1][j];
+    if (mode.target == Target::kDelta) return x;
+    return x - history_[lag][j];
+  };
+  int best = 0;
+  double best_score = -std::numeric_limits<double>::infinity();
+  for (int q = 0; q < 2 * kPoseDim; ++q) {
+    const Action pulse = probe_candidate(q, amplitude);
+    double score = 0.0;
+    for (int i = 0; i < kPoseDim; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      double mean = 0.0, second = 0.0;
+      for (int m = 0; m < kModes; ++m)
+        for (int j = 0; j < kPoseDim; ++j) {
+          const double d = drive_with(m, j, pulse[j]);
+          const auto at = static_cast<std::size_t>((i * kModes + m) * kPoseDim + j);
+          mean += d * w1[at];
+          second += d * d * w2[at];
+        }
+      const double a = model_.alpha[ii];
+      const double var = std::max(0.0, a * a * (second - mean * mean));
+      score += 0.5 * std::log1p(var / (model_.sigma[ii] * model_.sigma[ii]));
+    }
+    if (q == 0 || score > best_score + 1e-12 * std::abs(best_score)) {  // first on ties (up to rounding)
+      best = q;
+      best_score = score;
+    }
+  }
+  return best;
 }
 
 // ---- GrammarBeliefAdapter
 
 GrammarBeliefAdapter::GrammarBeliefAdapter(const ResponseModel& model, GrammarOptions options)
-    : belief_(model), options_(options) {
+    : belief_(model, options.scale, options.reanchor_period), options_(options) {
   if (options_.budget < 0) throw std::invalid_argument("probe budget must be nonnegative");
   if (!std::isfinite(options_.amplitude) || !(options_.amplitude > 0.0))
     throw std::invalid_argument("probe amplitude must be finite and positive");
@@ -219,7 +323,8 @@ GrammarBeliefAdapter::GrammarBeliefAdapter(const ResponseModel& model, GrammarOp
 
 int GrammarBeliefAdapter::probe_steps() const noexcept {
   switch (options_.probe) {
-    case GrammarProbe::kFixed: return options_.budget;
+    case GrammarProbe::kFixed:
+    case GrammarProbe::kEntropy: return options_.budget;
     case GrammarProbe::kHold: return options_.hold.total_steps();
     case GrammarProbe::kNone: break;
   }
@@ -245,7 +350,11 @@ Action GrammarBeliefAdapter::encode(const Action& canonical, const Mat3&) {
     raw = probing ? options_.hold.action(steps_) : task;
   } else {
     const Action task = belief_.map_encode(canonical, true);  // computed every step, as the reference
-    raw = probing ? fixed_probe_pulse(steps_, options_.amplitude) : task;
+    if (probing)
+      raw = options_.probe == GrammarProbe::kEntropy ? GrammarBelief::probe_candidate(belief_.select_entropy_probe(options_.amplitude), options_.amplitude)
+                                                     : fixed_probe_pulse(steps_, options_.amplitude);
+    else
+      raw = task;
   }
   if (!probing && !options_.belief_after_probe) raw = canonical;
   exec_step_ = steps_;
@@ -264,7 +373,7 @@ void GrammarBeliefAdapter::observe(const Action& raw, const Pose6& response, con
   if (options_.gripper_channel && have_fingers_) belief_.observe_gripper(raw[kGripper], fingers_);
   have_fingers_ = false;
   const bool hold = options_.probe == GrammarProbe::kHold && last_probe_;
-  belief_.update(raw, response, hold, hold && options_.hold.is_window_close(exec_step_));
+  belief_.update(raw, response, hold, hold && options_.hold.is_window_close(exec_step_), !last_probe_);
 }
 
 }  // namespace actionshift::adapt

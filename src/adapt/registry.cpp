@@ -25,8 +25,11 @@ namespace {
 nlohmann::json defaults(const std::string& m) {
   if (m == "oracle" || m == "no_adapt" || m == "exact_belief") return nlohmann::json::object();
   if (m == "grammar_belief")  // the reference's operating points: 6 fixed pulses of 0.5; hold h2-r1 over 6 channels
+    // the scale corrector's defaults are the reference's (§4.7: window 16, bounds 0.4..2.5, floor 0.05)
     return {{"probe", "none"},     {"budget", 6},        {"amplitude", 0.5},          {"hold_steps", 2},
-            {"hold_rounds", 1},    {"hold_channels", 6}, {"after_probe", "belief"}, {"gripper_channel", false}};
+            {"hold_rounds", 1},    {"hold_channels", 6}, {"after_probe", "belief"}, {"gripper_channel", false},
+            {"scale_correction", false}, {"scale_window", 16}, {"scale_min", 0.4},  {"scale_max", 2.5},
+            {"scale_floor", 0.05},  {"reanchor_period", 0}};
   nlohmann::json p = {{"budget", 6}, {"amplitude", 0.5}};
   if (m == "entropy_probes" || m == "dualabi") {
     p["calibrated_preview"] = true;
@@ -99,7 +102,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
     }
     throw InputError("method " + method, key, "must be one of " + list + " (got '" + v + "')");
   };
-  one_of("probe", {"none", "fixed", "hold"});
+  one_of("probe", {"none", "fixed", "hold", "entropy"});
   one_of("after_probe", {"belief", "identity"});
   auto int_in = [&](const char* key, int lo, int hi) {
     if (out.contains(key) && (out[key].get<int>() < lo || out[key].get<int>() > hi))
@@ -108,6 +111,16 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   int_in("hold_steps", 2, 1000);
   int_in("hold_rounds", 1, 1000);
   int_in("hold_channels", 1, kPoseDim);
+  int_in("scale_window", 1, 1000);
+  int_in("reanchor_period", 0, 1000000);
+  auto real_in = [&](const char* key, double lo, double hi, const char* what) {
+    if (!out.contains(key)) return;
+    const double v = out[key].get<double>();
+    if (!std::isfinite(v) || v < lo || v > hi) throw InputError("method " + method, key, what);
+  };
+  real_in("scale_min", 1e-9, 1.0, "must be finite and in (0, 1]");
+  real_in("scale_max", 1.0, 1e9, "must be finite and at least 1");
+  real_in("scale_floor", 0.0, 1e9, "must be finite and nonnegative");
   return out;
 }
 
@@ -123,6 +136,17 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
     o.hold = HoldSchedule(o.amplitude, p.at("hold_steps").get<int>(), p.at("hold_rounds").get<int>(), p.at("hold_channels").get<int>());
     o.belief_after_probe = p.at("after_probe").get<std::string>() == "belief";
     o.gripper_channel = p.at("gripper_channel").get<bool>();
+    if (probe == "entropy") o.probe = GrammarProbe::kEntropy;
+    if (p.at("scale_correction").get<bool>()) {
+      ScaleCorrectorOptions sc;
+      sc.window = p.at("scale_window").get<int>();
+      sc.min_correction = p.at("scale_min").get<double>();
+      sc.max_correction = p.at("scale_max").get<double>();
+      sc.command_floor = p.at("scale_floor").get<double>();
+      sc.fit = in.gain_fit;
+      o.scale = sc;
+    }
+    o.reanchor_period = p.at("reanchor_period").get<int>();
     if (o.gripper_channel && !in.model->has_gripper())
       throw InputError("method grammar_belief", "gripper_channel",
                        "the task's calibration has no finger channel (run `actionshift calibrate --gripper-channel`)");

@@ -1,6 +1,7 @@
 #include "actionshift/eval/experiment.hpp"
 
 #include "actionshift/adapt/registry.hpp"
+#include "actionshift/adapt/scale_corrector.hpp"
 #include "actionshift/adapt/response.hpp"
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
@@ -123,6 +124,7 @@ struct Context {
     if (oracle) in.truth = &oracle->contract();
     if (!pool.empty()) in.pool = &pool;
     if (response) in.model = &*response;
+    in.gain_fit = &adapt::fit_window_gain;  // the scale corrector's least-squares fit by Ceres (ActionShift::fit)
     const auto adapter = adapt::make_adapter(job.method, params, in);
 
     Eigen::VectorXd obs = env.reset(t.episode_seed);

@@ -272,10 +272,12 @@ TEST(GrammarProbing, FlailThenIdentitySendsTheIntentUnchanged) {
 TEST(GrammarParams, DefaultsAndMalformed) {
   const auto p = resolve_method_params("grammar_belief");
   EXPECT_EQ(p.dump(),
-            R"({"after_probe":"belief","amplitude":0.5,"budget":6,"gripper_channel":false,"hold_channels":6,"hold_rounds":1,"hold_steps":2,"probe":"none"})");
+            R"({"after_probe":"belief","amplitude":0.5,"budget":6,"gripper_channel":false,"hold_channels":6,"hold_rounds":1,"hold_steps":2,"probe":"none",)"
+            R"("reanchor_period":0,"scale_correction":false,"scale_floor":0.05,"scale_max":2.5,"scale_min":0.4,"scale_window":16})");
   EXPECT_EQ(resolve_method_params("grammar_belief", {{"probe", "hold"}, {"hold_rounds", 2}})["hold_rounds"], 2);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"pool", "full"}}), InputError);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"probe", "entropyish"}}), InputError);
+  EXPECT_NO_THROW(resolve_method_params("grammar_belief", {{"probe", "entropy"}}));
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"probe", 1}}), InputError);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"hold_steps", -2}}), InputError);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"hold_steps", 1}}), InputError);

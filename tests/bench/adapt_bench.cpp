@@ -3,7 +3,8 @@
 // <= 15 us for 9 hypotheses, <= 60 us and <= 90 us for the full pool (issue 18). The batched belief
 // is timed per call at 1, 8 and 1024 environments. scripts/bench_adapt_table regenerates the table
 // in docs/results/benchmarks.md from this executable's JSON output. Grammar belief (issue 11): one update
-// <= 20 us; one action selection (MAP resolution over the 8 modes and the encode) <= 200 us.
+// <= 20 us; one action selection (MAP resolution over the 8 modes and the encode) and one entropy-probe
+// selection <= 200 us each; the scale corrector's Ceres fit of one channel (16-step window) is timed too.
 #include "actionshift/adapt/batched_belief.hpp"
 #include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/methods.hpp"
@@ -13,6 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <vector>
 
 namespace {
 
@@ -102,6 +104,46 @@ void BM_GrammarSelect(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_GrammarSelect);
+
+// one entropy-probe selection of the grammar belief (12 pulses, every cell's posterior moments)
+void BM_GrammarEntropySelect(benchmark::State& state) {
+  GrammarBelief b(kModel);
+  Decoder env(reference::representative_contracts("seen")[1]);
+  for (int k = 0; k < 3; ++k) {
+    const Action raw = GrammarBelief::probe_candidate(k, 0.5);
+    b.update(raw, kModel.expected(env.step(raw)));
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(b.select_entropy_probe(0.5));
+}
+BENCHMARK(BM_GrammarEntropySelect);
+
+// one update with the scale corrector on (amortised over its window: every 16th update fits)
+void BM_GrammarUpdateCorrected(benchmark::State& state) {
+  GrammarBelief b(kModel, ScaleCorrectorOptions{});
+  Decoder env(reference::representative_contracts("seen")[1]);
+  int k = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Action raw = b.map_encode(intent(k++));
+    const Pose6 obs = kModel.expected(env.step(raw));
+    state.ResumeTiming();
+    b.update(raw, obs);
+    if (k % 200 == 0) b.reset();
+  }
+  state.SetLabel(std::to_string(b.corrector()->fits()) + " channel fits since the last reset");
+}
+BENCHMARK(BM_GrammarUpdateCorrected);
+
+// one Ceres least-squares fit of one channel over a 16-step window
+void BM_ScaleFitCeres(benchmark::State& state) {
+  std::vector<double> c(16), o(16);
+  for (std::size_t t = 0; t < c.size(); ++t) {
+    c[t] = 0.2 + 0.05 * static_cast<double>(t % 7);
+    o[t] = 0.03 * 1.1 * c[t] * (1.0 + 0.01 * std::sin(static_cast<double>(t)));
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(fit_window_gain(c, o, 0.03, 1.0, 0.4, 2.5));
+}
+BENCHMARK(BM_ScaleFitCeres)->Unit(benchmark::kMicrosecond);
 // one batched update of n environments (inputs precomputed: a 50-step episode per environment)
 void BM_BatchedBeliefUpdate(benchmark::State& state) {
   const int n = static_cast<int>(state.range(1));

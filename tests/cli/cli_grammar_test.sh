@@ -36,9 +36,28 @@ run "$AS" run --task pick_cube --split unseen_composition --method grammar_belie
 expect_rc 0 "hold h2-r2"
 [ "$(ls "$TMP"/h/*.summary.json | wc -l)" = 2 ] && ok || bad "h2-r2 has its own job id"
 
+# the entropy-probing variant and the scale corrector (with re-anchoring) are runnable and hash-addressed
+run "$AS" run --task push_cube --split seen --method grammar_belief --params '{"probe":"entropy"}' --episodes 2 --threads 1 \
+  --out "$TMP/e" --progress off
+expect_rc 0 "grammar_belief entropy probes"
+grep -q '"probe_steps":[1-9]' "$TMP"/e/*.jsonl && ok || bad "entropy probing records its probe steps"
+run "$AS" run --task pick_cube --split unseen_composition --method grammar_belief \
+  --params '{"probe":"hold","scale_correction":true,"scale_window":8}' --episodes 2 --threads 1 --out "$TMP/sc" --progress off
+expect_rc 0 "grammar_belief hold + scale corrector"
+grep -q '"scale_correction": true' "$TMP"/sc/*.summary.json && ok || bad "the corrector enters the job"
+grep -q '"scale_window": 8' "$TMP"/sc/*.summary.json && ok || bad "the corrector's window enters the job"
+run "$AS" run --task pick_cube --split unseen_composition --method grammar_belief \
+  --params '{"probe":"hold","scale_correction":true,"scale_window":8}' --episodes 2 --threads 1 --out "$TMP/sc" --progress off
+expect_out "already complete" "re-run of a finished scale-corrector job"
+run "$AS" run --task pick_cube --split seen --method grammar_belief --params '{"reanchor_period":8}' --episodes 2 --threads 1 \
+  --out "$TMP/ra" --progress off
+expect_rc 0 "grammar_belief re-anchoring"
+
 # malformed parameters: one line, exit 2
 for p in '{"hold_steps":-2}' '{"hold_steps":1}' '{"holdsteps":2}' '{"probe":"wiggle"}' '{"amplitude":NaN}' \
-         '{"amplitude":-0.5}' '{"budget":-1}' '{"gripper_channel":"yes"}' '[1]'; do
+         '{"amplitude":-0.5}' '{"budget":-1}' '{"gripper_channel":"yes"}' '[1]' '{"scale_min":-0.4}' '{"scale_max":0.5}' \
+         '{"scale_max":NaN}' '{"scale_window":0}' '{"scale_floor":-1}' '{"scale_corection":true}' '{"reanchor_period":-1}' \
+         '{"scale_correction":1}'; do
   run "$AS" run --task pick_cube --split seen --method grammar_belief --params "$p" --episodes 2 --out "$TMP/x" --progress off
   expect_rc 2 "params $p"
   expect_one_line_error "params $p"

@@ -19,10 +19,12 @@
 
 #include "actionshift/adapt/adapter.hpp"
 #include "actionshift/adapt/response.hpp"
+#include "actionshift/adapt/scale_corrector.hpp"
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/types.hpp"
 
 #include <array>
+#include <optional>
 #include <string>
 
 namespace actionshift::adapt {
@@ -76,8 +78,12 @@ class GrammarBelief {
     double total{0};  ///< summed evidence of the chosen cells
   };
 
-  /// Throws std::invalid_argument for an invalid response model.
-  explicit GrammarBelief(const ResponseModel& model);
+  /// Throws std::invalid_argument for an invalid response model, invalid corrector options or a
+  /// negative re-anchoring period. `scale`: run the scale corrector (the reference's §4.7) with these
+  /// options; `reanchor_period` > 0: every that many updates the translation channels of the tracked
+  /// target are set to the observed cumulative response (the reference's §4.8; 0 = off).
+  explicit GrammarBelief(const ResponseModel& model, std::optional<ScaleCorrectorOptions> scale = std::nullopt,
+                         int reanchor_period = 0);
 
   const ResponseModel& model() const noexcept { return model_; }
 
@@ -87,7 +93,21 @@ class GrammarBelief {
   /// One transition: push `raw` into the history, then add the evidence of `observed` (the TCP
   /// response). `hold`: this step is a hold-probe step (its evidence only enters through the
   /// window term); `window_close`: the hold window ends with this step.
-  void update(const Action& raw, const Pose6& observed, bool hold = false, bool window_close = false);
+  /// `corrector_active`: the scale corrector may learn from this step (false on probe steps).
+  void update(const Action& raw, const Pose6& observed, bool hold = false, bool window_close = false, bool corrector_active = true);
+
+  /// The entropy probe (our variant; the reference runs its factorized belief passive or with fixed
+  /// or hold probes only): among the 12 pulses +a·e_0..+a·e_5, −a·e_0..−a·e_5 (gripper 0), the index
+  /// of the one whose predicted response is most informative about the cells. Per output channel i
+  /// the belief's cell posterior p_i(m,j,s,k) ∝ exp S[m,i,j,s,k] predicts the response
+  /// α_i·drive_m,j(pulse)·sign_s·scale_k (lag-aware: the pulse only drives lag-0 modes); with the
+  /// same Gaussian noise σ_i under every cell, the information the response carries about the cell
+  /// is its predictive entropy minus a constant, bounded by the moment-matched Gaussian's
+  /// ½·log(1 + Var_i/σ_i²). The pulse maximising Σ_i of that bound is chosen (first on ties).
+  /// Allocation-free; cost O(12·M·D²·S·K).
+  int select_entropy_probe(double amplitude) const;
+  /// The pulse of `select_entropy_probe`'s index (0..5: +a on that channel, 6..11: −a on channel − 6).
+  static Action probe_candidate(int index, double amplitude);
 
   /// The MAP contract (cached until the next update). With zero evidence: perm identity, sign −1,
   /// scale 0.5, delta, lag 0 (the first max of every cell and the identity assignment).
@@ -106,6 +126,9 @@ class GrammarBelief {
 
   /// Tracked target ← observed cumulative response (the hold adapter, at the end of its probe).
   void anchor_tracked_target() { target_ = observed_cumulative_; }
+  /// The scale corrector, if enabled.
+  const std::optional<ScaleCorrector>& corrector() const noexcept { return corrector_; }
+  int reanchor_period() const noexcept { return reanchor_period_; }
 
   const Pose6& tracked_target() const noexcept { return target_; }
   /// S[m,i,j,s,k].
@@ -131,23 +154,33 @@ class GrammarBelief {
   std::array<Pose6, kModes> hold_base_{};
   int hold_len_{0};
   std::array<double, 2> gscore_{};
+  std::optional<ScaleCorrector> corrector_;
+  bool have_command_{false};            // a map_encode command is waiting for its response
+  Pose6 last_command_{Pose6::Zero()};   // the canonical pose of the last map_encode
+  Pose6 last_eff_scale_{Pose6::Ones()}; // the scale it was encoded with
+  int reanchor_period_{0};
+  int steps_since_reset_{0};
   mutable bool map_valid_{false};
   mutable Map map_;
 };
 
 /// How the grammar-belief adapter excites the robot at the start of an episode.
-enum class GrammarProbe { kNone, kFixed, kHold };
+enum class GrammarProbe { kNone, kFixed, kHold, kEntropy };
 
 struct GrammarOptions {
   GrammarProbe probe{GrammarProbe::kNone};
-  int budget{6};            ///< kFixed: probe steps (the fixed pulse sequence)
-  double amplitude{0.5};    ///< kFixed: pulse amplitude
+  int budget{6};            ///< kFixed, kEntropy: probe steps
+  double amplitude{0.5};    ///< kFixed, kEntropy: pulse amplitude
   HoldSchedule hold{};      ///< kHold: the schedule
   /// After the probe phase: act on the belief (true) or send the canonical intent unchanged
   /// (false; the causal control "flail then identity").
   bool belief_after_probe{true};
   /// Score the gripper inversion on the finger channel (the model must have one).
   bool gripper_channel{false};
+  /// Run the scale corrector with these options (off when empty).
+  std::optional<ScaleCorrectorOptions> scale{};
+  /// Re-anchor the tracked target's translation every that many steps (0 = off).
+  int reanchor_period{0};
 };
 
 /// The grammar-belief adapter (method `grammar_belief`). Privileged with the grammar and the

@@ -4,6 +4,7 @@
 /// grammar_belief (grammar + calibration only; no pool).
 
 #include "actionshift/adapt/adapter.hpp"
+#include "actionshift/adapt/scale_corrector.hpp"
 #include "actionshift/adapt/response.hpp"
 #include "actionshift/core/contract.hpp"
 
@@ -20,6 +21,7 @@ struct MethodInputs {
   const Contract* truth{nullptr};             ///< oracle only
   const std::vector<Contract>* pool{nullptr};  ///< pool-privileged methods
   const ResponseModel* model{nullptr};        ///< belief methods (from the task's calibration)
+  GainFit gain_fit{nullptr};                  ///< grammar_belief's scale corrector: its least-squares fit (null: closed form)
 };
 
 /// Every method name, in ladder order (ceiling first).
