@@ -14,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -486,7 +487,14 @@ void PhysicsWorld::compute_mass_matrix() {
       axis.col(j) = eig(robot_->localDirToWorld(j, lj.getAxisBottom(0)));
     }
   }
+  // Each body adds m Jv^T Jv + Jw^T (R I R^T) Jw, whose entries are nonzero only between the joints
+  // that move it (its ancestors). The sums are formed term by term in the order Eigen's dynamic-size
+  // products used here before (inner index 0, 1, 2; the mass as the product's scale factor; Jw^T I
+  // first), so M is the same bit for bit, without the general matrix-product kernels and their
+  // temporaries on 9 x 9 zero-padded operands.
   mass_.setZero();
+  std::array<int, kMaxDofs> anc{};
+  std::array<Eigen::Vector3d, kMaxDofs> jv, jw, jwi;
   for (int i = 0; i < n; ++i) {
     const btMultibodyLink& link = robot_->getLink(i);
     const Eigen::Vector3d com = eig(robot_->localPosToWorld(i, btVector3(0, 0, 0)));
@@ -495,22 +503,44 @@ void PhysicsWorld::compute_mass_matrix() {
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < 3; ++c) r(a, c) = basis[a][c];
     const Eigen::Vector3d inertia_local = eig(link.m_inertiaLocal);
-    jac_scratch_.setZero();
+    int na = 0;
     for (int j = i; j >= 0; j = robot_->getLink(j).m_parent) {
       const btMultibodyLink& lj = robot_->getLink(j);
+      const auto k = static_cast<std::size_t>(na);
+      anc[k] = j;
+      jv[k].setZero();
+      jw[k].setZero();
       if (lj.m_jointType == btMultibodyLink::eRevolute) {
         const Eigen::Vector3d a = axis.col(j);
-        jac_scratch_.block<3, 1>(0, j) = a.cross(com - pivot.col(j));
-        jac_scratch_.block<3, 1>(3, j) = a;
+        jv[k] = a.cross(com - pivot.col(j));
+        jw[k] = a;
       } else if (lj.m_jointType == btMultibodyLink::ePrismatic) {
-        jac_scratch_.block<3, 1>(0, j) = axis.col(j);
+        jv[k] = axis.col(j);
       }
+      ++na;
     }
     const Eigen::Matrix3d inertia_world = r * inertia_local.asDiagonal() * r.transpose();
-    const auto jv = jac_scratch_.topRows<3>();
-    const auto jw = jac_scratch_.bottomRows<3>();
-    mass_.noalias() += link.m_mass * jv.transpose() * jv;
-    mass_.noalias() += jw.transpose() * inertia_world * jw;
+    const double m = link.m_mass;
+    for (int x = 0; x < na; ++x) {  // (Jw^T I) row of joint x
+      const auto xi = static_cast<std::size_t>(x);
+      for (int c = 0; c < 3; ++c)
+        jwi[xi][c] = jw[xi][0] * inertia_world(0, c) + jw[xi][1] * inertia_world(1, c) + jw[xi][2] * inertia_world(2, c);
+    }
+    for (int x = 0; x < na; ++x) {
+      const auto xi = static_cast<std::size_t>(x);
+      for (int y = 0; y < na; ++y) {
+        const auto yi = static_cast<std::size_t>(y);
+        double lin = jv[xi][0] * jv[yi][0];
+        lin += jv[xi][1] * jv[yi][1];
+        lin += jv[xi][2] * jv[yi][2];
+        double ang = jwi[xi][0] * jw[yi][0];
+        ang += jwi[xi][1] * jw[yi][1];
+        ang += jwi[xi][2] * jw[yi][2];
+        double& e = mass_(anc[xi], anc[yi]);
+        e += lin * m;
+        e += ang;
+      }
+    }
   }
 }
 
