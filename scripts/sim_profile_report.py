@@ -93,6 +93,7 @@ def main():
     ap.add_argument("--raw-steps", type=int, default=0)
     ap.add_argument("--baseline", help="an earlier sim_profile.json whose callgrind figures are shown as 'before'")
     ap.add_argument("--baseline-label", default="before")
+    ap.add_argument("--baseline-raw", help="`bench env --raw-bullet --json` lines of the baseline binary, run interleaved with --raw")
     a = ap.parse_args()
 
     funcs, total = parse_inclusive(a.inclusive)
@@ -149,22 +150,28 @@ def main():
             "functions": {k: names[k] for k in names},
         }
 
-    raw = {}
-    with open(a.raw, encoding="utf-8") as f:
-        for line in f:
-            if line.strip():
-                r = json.loads(line)
-                raw.setdefault(r["task"], []).append(r)
-    raw_summary = {}
-    for task, runs in raw.items():
-        raw_summary[task] = {
-            "runs": len(runs),
-            "env_us_per_step": statistics.median(r["env_us_per_step"] for r in runs),
-            "raw_us_per_step": statistics.median(r["raw_us_per_step"] for r in runs),
-            "raw_share": statistics.median(r["raw_share"] for r in runs),
-            "identical": all(r["identical"] for r in runs),
-            "all_shares": [round(r["raw_share"], 4) for r in runs],
-        }
+    def summarize_raw(path):
+        raw = {}
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                if line.strip():
+                    r = json.loads(line)
+                    raw.setdefault(r["task"], []).append(r)
+        out = {}
+        for task, runs in raw.items():
+            out[task] = {
+                "runs": len(runs),
+                "env_us_per_step": statistics.median(r["env_us_per_step"] for r in runs),
+                "raw_us_per_step": statistics.median(r["raw_us_per_step"] for r in runs),
+                "raw_share": statistics.median(r["raw_share"] for r in runs),
+                "identical": all(r["identical"] for r in runs),
+                "all_env_us": [r["env_us_per_step"] for r in runs],
+                "all_shares": [round(r["raw_share"], 4) for r in runs],
+            }
+        return out
+
+    raw_summary = summarize_raw(a.raw)
+    raw_base = summarize_raw(a.baseline_raw) if a.baseline_raw else None
 
     doc = {
         "measured": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -174,6 +181,8 @@ def main():
         "callgrind": prof,
         "raw_bullet": raw_summary,
     }
+    if raw_base:
+        doc["raw_bullet_baseline"] = raw_base
     old = {}
     try:
         with open(a.json, encoding="utf-8") as f:
@@ -257,13 +266,20 @@ def main():
             "and the same bodies are stepped with those inputs and no controller work:"
         )
         lines.append("")
-        lines.append("| task | `Env::step` [µs] | raw Bullet, same world [µs] | Bullet share of `Env::step` | replay bit-identical |")
-        lines.append("|---|---:|---:|---:|---|")
+        if raw_base:
+            lines.append(f"| task | `Env::step` [µs] | raw Bullet, same world [µs] | Bullet share of `Env::step` | replay bit-identical "
+                         f"| {a.baseline_label}: `Env::step` [µs] | raw Bullet [µs] | share |")
+            lines.append("|---|---:|---:|---:|---|---:|---:|---:|")
+        else:
+            lines.append("| task | `Env::step` [µs] | raw Bullet, same world [µs] | Bullet share of `Env::step` | replay bit-identical |")
+            lines.append("|---|---:|---:|---:|---|")
         for task, r in raw_summary.items():
-            lines.append(
-                f"| {task} | {r['env_us_per_step']:.0f} | {r['raw_us_per_step']:.0f} | **{100 * r['raw_share']:.1f} %** "
-                f"| {'yes' if r['identical'] else 'NO'} |"
-            )
+            row = (f"| {task} | {r['env_us_per_step']:.0f} | {r['raw_us_per_step']:.0f} | **{100 * r['raw_share']:.1f} %** "
+                   f"| {'yes' if r['identical'] else 'NO'} |")
+            if raw_base and task in raw_base:
+                b = raw_base[task]
+                row += f" {b['env_us_per_step']:.0f} | {b['raw_us_per_step']:.0f} | {100 * b['raw_share']:.1f} % |"
+            lines.append(row)
         lines.append("")
     block = "\n".join(lines).rstrip() + "\n"
     with open(a.page, encoding="utf-8") as f:
