@@ -203,7 +203,6 @@ PhysicsWorld::PhysicsWorld(const RobotDescription& desc, const ArticulationLayou
     throw std::invalid_argument("robot '" + desc.name + "': " + std::to_string(arm_dofs_.size()) + " driven joints, at most " +
                                 std::to_string(kMaxArmDofs) + " supported");
   mass_ = Eigen::MatrixXd::Zero(num_dofs(), num_dofs());
-  jac_scratch_ = Eigen::MatrixXd::Zero(6, num_dofs());
 }
 
 void PhysicsWorld::detach_all() {

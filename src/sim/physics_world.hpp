@@ -158,7 +158,6 @@ class PhysicsWorld {
   Eigen::VectorXd q_target_;
   std::vector<int> arm_dofs_;       // bodies driven as arm joints (every non-finger body)
   Eigen::MatrixXd mass_;            // joint-space inertia scratch (num_dofs square)
-  Eigen::MatrixXd jac_scratch_;     // 6 x num_dofs scratch
   std::vector<Eigen::Vector3d> finger_forces_;  // [finger slot * num objects + object]
 };
 
