@@ -53,6 +53,7 @@ struct BenchEnvOptions {
   long long steps = 12000;         ///< control steps per thread (short runs are dominated by machine noise)
   int threads = 0;                 ///< 0: all hardware threads
   bool json = false;               ///< one JSON object: task, threads, steps_per_s_one_thread, steps_per_s_all_threads
+  bool raw_bullet = false;         ///< instead: Env::step against the same world stepped with no controller work
   RobotOptions robot;              ///< --robot/--package
 };
 int run_bench_env(const BenchEnvOptions& o);

@@ -93,6 +93,10 @@ int main(int argc, char** argv) {
   bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
       ->capture_default_str();
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
+  bench_env->add_flag("--raw-bullet", bench_env_o.raw_bullet,
+                      "Instead of throughput: time Env::step on one thread while recording what the controller hands\n"
+                      "Bullet, then step the same rebuilt world with those inputs and no controller work (the raw-Bullet\n"
+                      "limit); prints both per-step times, their ratio and whether the replay was bit-identical");
   add_robot_options(bench_env, bench_env_o.robot);
   bench_env->callback([&] { action = [&] { return cli::run_bench_env(bench_env_o); }; });
 

@@ -14,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -46,8 +47,14 @@ constexpr int kMaskAll = btBroadphaseProxy::AllFilter;
 
 // largest number of driven (non-finger) joints the implicit drive's fixed-capacity solve handles
 constexpr int kMaxArmDofs = 16;
+// largest number of movable bodies (arm and fingers) the inertia computation's fixed-capacity scratch handles
+constexpr int kMaxDofs = 32;
+
+thread_local BulletInputRecorder* t_recorder = nullptr;
 
 }  // namespace
+
+void set_thread_input_recorder(BulletInputRecorder* r) { t_recorder = r; }
 
 // ---- articulation layout
 
@@ -189,11 +196,13 @@ PhysicsWorld::PhysicsWorld(const RobotDescription& desc, const ArticulationLayou
   q_target_ = Eigen::VectorXd::Zero(num_dofs());
   for (int i = 0; i < num_dofs(); ++i)
     if (!is_finger(i)) arm_dofs_.push_back(i);
+  if (num_dofs() > kMaxDofs)
+    throw std::invalid_argument("robot '" + desc.name + "': " + std::to_string(num_dofs()) + " movable joints, at most " +
+                                std::to_string(kMaxDofs) + " supported");
   if (static_cast<int>(arm_dofs_.size()) > kMaxArmDofs)
     throw std::invalid_argument("robot '" + desc.name + "': " + std::to_string(arm_dofs_.size()) + " driven joints, at most " +
                                 std::to_string(kMaxArmDofs) + " supported");
   mass_ = Eigen::MatrixXd::Zero(num_dofs(), num_dofs());
-  jac_scratch_ = Eigen::MatrixXd::Zero(6, num_dofs());
 }
 
 void PhysicsWorld::detach_all() {
@@ -286,6 +295,7 @@ void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::
   }
   finger_forces_.assign(finger_bodies_.size() * objects_.size(), Eigen::Vector3d::Zero());
   q_target_ = qpos;
+  if (t_recorder != nullptr) t_recorder->world = this;
 }
 
 void PhysicsWorld::build_robot(const Eigen::VectorXd& qpos) {
@@ -404,18 +414,28 @@ void PhysicsWorld::step_control() {
   const double k_over_d = cfg_.drive_stiffness / cfg_.drive_damping;
   const btVector3 g = world_->getGravity();
   const int steps = cfg_.sim_steps_per_control * cfg_.substeps_per_sim_step;
+  BulletInputRecorder* rec = t_recorder != nullptr && t_recorder->recording ? t_recorder : nullptr;
   for (int s = 0; s < steps; ++s) {
-    if (cfg_.arm_drive == ArmDrive::kImplicitPd) apply_implicit_pd();
+    std::size_t row = 0;
+    if (rec) {
+      row = rec->inputs.size();
+      rec->inputs.resize(row + 3 * static_cast<std::size_t>(n), 0.0);
+    }
+    if (cfg_.arm_drive == ArmDrive::kImplicitPd) apply_implicit_pd(rec ? rec->inputs.data() + row : nullptr);
     for (int i = 0; i < n; ++i) {
       const double q = robot_->getJointPos(i);
       const double err = q_target_(i) - q;
       btMultiBodyJointMotor* motor = motors_[static_cast<std::size_t>(i)];
       // overdamped pd (K, D) reduced to its dominant first-order mode: v* = (K/D)(q* - q)
-      if (motor != nullptr) motor->setVelocityTarget(k_over_d * err, 1.0);
+      if (motor != nullptr) {
+        motor->setVelocityTarget(k_over_d * err, 1.0);
+        if (rec) rec->inputs[row + 3 * static_cast<std::size_t>(i) + 1] = k_over_d * err;
+      }
       if (is_finger(i)) {
         // a blocked pd drive pushes with K*|q*-q|: cap the motor at that (and at the force limit)
         const double f = std::min(cfg_.finger_force_limit, cfg_.drive_stiffness * std::abs(err));
         motor->setMaxAppliedImpulse(f * h_);
+        if (rec) rec->inputs[row + 3 * static_cast<std::size_t>(i) + 2] = f * h_;
       }
       // exact gravity compensation: cancels the m*g the world applies to every link
       if (cfg_.gravity_compensation) robot_->addLinkForce(i, -g * robot_->getLinkMass(i));
@@ -423,6 +443,26 @@ void PhysicsWorld::step_control() {
     world_->stepSimulation(h_, 0, h_);
   }
   compute_contact_forces();
+}
+
+void PhysicsWorld::replay_control(const double* inputs) {
+  const int n = num_dofs();
+  const btVector3 g = world_->getGravity();
+  const int steps = cfg_.sim_steps_per_control * cfg_.substeps_per_sim_step;
+  for (int s = 0; s < steps; ++s, inputs += 3 * n) {
+    for (int i = 0; i < n; ++i) {
+      const double* in = inputs + 3 * i;
+      btMultiBodyJointMotor* motor = motors_[static_cast<std::size_t>(i)];
+      if (motor == nullptr) {
+        if (cfg_.arm_drive == ArmDrive::kImplicitPd) robot_->addJointTorque(i, in[0]);
+      } else {
+        motor->setVelocityTarget(in[1], 1.0);
+        if (is_finger(i)) motor->setMaxAppliedImpulse(in[2]);
+      }
+      if (cfg_.gravity_compensation) robot_->addLinkForce(i, -g * robot_->getLinkMass(i));
+    }
+    world_->stepSimulation(h_, 0, h_);
+  }
 }
 
 bool PhysicsWorld::is_finger(int body) const {
@@ -433,7 +473,27 @@ void PhysicsWorld::compute_mass_matrix() {
   // M = sum over bodies of m Jv^T Jv + Jw^T (R I R^T) Jw, with the geometric jacobians of each body's
   // centre of mass built from bullet's own kinematics of the current state (world frame)
   const int n = num_dofs();
+  // every joint's world axis and pivot once: each body's jacobian uses those of all its ancestors,
+  // and each Bullet query walks the chain to the base (the same calls, so the same values, as
+  // querying them again for every descendant)
+  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxDofs> axis(3, n), pivot(3, n);
+  for (int j = 0; j < n; ++j) {
+    const btMultibodyLink& lj = robot_->getLink(j);
+    if (lj.m_jointType == btMultibodyLink::eRevolute) {
+      axis.col(j) = eig(robot_->localDirToWorld(j, lj.getAxisTop(0)));
+      pivot.col(j) = eig(robot_->localPosToWorld(j, -lj.m_dVector));
+    } else if (lj.m_jointType == btMultibodyLink::ePrismatic) {
+      axis.col(j) = eig(robot_->localDirToWorld(j, lj.getAxisBottom(0)));
+    }
+  }
+  // Each body adds m Jv^T Jv + Jw^T (R I R^T) Jw, whose entries are nonzero only between the joints
+  // that move it (its ancestors). The sums are formed term by term in the order Eigen's dynamic-size
+  // products used here before (inner index 0, 1, 2; the mass as the product's scale factor; Jw^T I
+  // first), so M is the same bit for bit, without the general matrix-product kernels and their
+  // temporaries on 9 x 9 zero-padded operands.
   mass_.setZero();
+  std::array<int, kMaxDofs> anc{};
+  std::array<Eigen::Vector3d, kMaxDofs> jv, jw, jwi;
   for (int i = 0; i < n; ++i) {
     const btMultibodyLink& link = robot_->getLink(i);
     const Eigen::Vector3d com = eig(robot_->localPosToWorld(i, btVector3(0, 0, 0)));
@@ -442,27 +502,48 @@ void PhysicsWorld::compute_mass_matrix() {
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < 3; ++c) r(a, c) = basis[a][c];
     const Eigen::Vector3d inertia_local = eig(link.m_inertiaLocal);
-    jac_scratch_.setZero();
+    int na = 0;
     for (int j = i; j >= 0; j = robot_->getLink(j).m_parent) {
       const btMultibodyLink& lj = robot_->getLink(j);
+      const auto k = static_cast<std::size_t>(na);
+      anc[k] = j;
+      jv[k].setZero();
+      jw[k].setZero();
       if (lj.m_jointType == btMultibodyLink::eRevolute) {
-        const Eigen::Vector3d axis = eig(robot_->localDirToWorld(j, lj.getAxisTop(0)));
-        const Eigen::Vector3d pivot = eig(robot_->localPosToWorld(j, -lj.m_dVector));
-        jac_scratch_.block<3, 1>(0, j) = axis.cross(com - pivot);
-        jac_scratch_.block<3, 1>(3, j) = axis;
+        const Eigen::Vector3d a = axis.col(j);
+        jv[k] = a.cross(com - pivot.col(j));
+        jw[k] = a;
       } else if (lj.m_jointType == btMultibodyLink::ePrismatic) {
-        jac_scratch_.block<3, 1>(0, j) = eig(robot_->localDirToWorld(j, lj.getAxisBottom(0)));
+        jv[k] = axis.col(j);
       }
+      ++na;
     }
     const Eigen::Matrix3d inertia_world = r * inertia_local.asDiagonal() * r.transpose();
-    const auto jv = jac_scratch_.topRows<3>();
-    const auto jw = jac_scratch_.bottomRows<3>();
-    mass_.noalias() += link.m_mass * jv.transpose() * jv;
-    mass_.noalias() += jw.transpose() * inertia_world * jw;
+    const double m = link.m_mass;
+    for (int x = 0; x < na; ++x) {  // (Jw^T I) row of joint x
+      const auto xi = static_cast<std::size_t>(x);
+      for (int c = 0; c < 3; ++c)
+        jwi[xi][c] = jw[xi][0] * inertia_world(0, c) + jw[xi][1] * inertia_world(1, c) + jw[xi][2] * inertia_world(2, c);
+    }
+    for (int x = 0; x < na; ++x) {
+      const auto xi = static_cast<std::size_t>(x);
+      for (int y = 0; y < na; ++y) {
+        const auto yi = static_cast<std::size_t>(y);
+        double lin = jv[xi][0] * jv[yi][0];
+        lin += jv[xi][1] * jv[yi][1];
+        lin += jv[xi][2] * jv[yi][2];
+        double ang = jwi[xi][0] * jw[yi][0];
+        ang += jwi[xi][1] * jw[yi][1];
+        ang += jwi[xi][2] * jw[yi][2];
+        double& e = mass_(anc[xi], anc[yi]);
+        e += lin * m;
+        e += ang;
+      }
+    }
   }
 }
 
-void PhysicsWorld::apply_implicit_pd() {
+void PhysicsWorld::apply_implicit_pd(double* record) {
   // PhysX-style implicit PD drive on the arm joints. With tau = K (q* - q - h v') - D v' and
   // v' = v + h M^-1 tau over one step h, the end-of-step velocity solves
   //   (M + h (h K + D) I) v' = M v + h K (q* - q)
@@ -487,6 +568,7 @@ void PhysicsWorld::apply_implicit_pd() {
   for (int r = 0; r < na; ++r) {
     const double tau = std::clamp(k * err(r) - (h_ * k + d) * v_next(r), -cfg_.arm_force_limit, cfg_.arm_force_limit);
     robot_->addJointTorque(arm_dofs_[static_cast<std::size_t>(r)], tau);
+    if (record) record[3 * static_cast<std::size_t>(arm_dofs_[static_cast<std::size_t>(r)])] = tau;
   }
 }
 

@@ -65,6 +65,21 @@ struct ArticulationLayout {
   int body_of_joint(int joint) const;
 };
 
+class PhysicsWorld;
+
+/// What the controller hands Bullet, recorded so the same world can later be stepped with no
+/// controller work (the raw-Bullet limit of `actionshift bench env --raw-bullet`). While a recorder
+/// is installed on a thread, every PhysicsWorld of that thread notes itself in `world` when it is
+/// rebuilt and appends, for every Bullet step, 3 values per body: the arm drive's joint torque, the
+/// motor's velocity target and the motor's impulse cap (0 where a body has none).
+struct BulletInputRecorder {
+  PhysicsWorld* world{nullptr};
+  std::vector<double> inputs;
+  bool recording{true};
+};
+/// Install `r` for the calling thread (nullptr removes it). Nothing is recorded otherwise.
+void set_thread_input_recorder(BulletInputRecorder* r);
+
 /// Per-worker Bullet world: the Panda multibody, the table, task objects.
 class PhysicsWorld {
  public:
@@ -81,6 +96,13 @@ class PhysicsWorld {
   void set_targets(const Eigen::VectorXd& q_target) { q_target_ = q_target; }
   /// Advance one control step (sim_steps_per_control * substeps Bullet steps).
   void step_control();
+  /// Values a recorder appends per control step (3 per body per Bullet step).
+  int inputs_per_control_step() const { return 3 * num_dofs() * cfg_.sim_steps_per_control * cfg_.substeps_per_sim_step; }
+  /// One control step with recorded inputs (inputs_per_control_step() values) and no controller work:
+  /// the drive torques, motor targets and impulse caps are applied as recorded and Bullet is stepped.
+  /// From the same rebuilt state it reproduces step_control's states bit for bit; the finger
+  /// contact forces are not updated.
+  void replay_control(const double* inputs);
 
   int num_dofs() const { return static_cast<int>(layout_.bodies.size()); }
   Eigen::VectorXd qpos() const;
@@ -101,8 +123,9 @@ class PhysicsWorld {
   void compute_contact_forces();
   /// Joint-space inertia matrix of the multibody at its current state (num_dofs square) into mass_.
   void compute_mass_matrix();
-  /// Arm torques of the implicit PD drive for one Bullet step of length h_, applied with addJointTorque.
-  void apply_implicit_pd();
+  /// Arm torques of the implicit PD drive for one Bullet step of length h_, applied with addJointTorque
+  /// (and written to record[3 * body] when `record` is non-null).
+  void apply_implicit_pd(double* record = nullptr);
   bool is_finger(int body) const;
 
   const RobotDescription& desc_;
@@ -135,7 +158,6 @@ class PhysicsWorld {
   Eigen::VectorXd q_target_;
   std::vector<int> arm_dofs_;       // bodies driven as arm joints (every non-finger body)
   Eigen::MatrixXd mass_;            // joint-space inertia scratch (num_dofs square)
-  Eigen::MatrixXd jac_scratch_;     // 6 x num_dofs scratch
   std::vector<Eigen::Vector3d> finger_forces_;  // [finger slot * num objects + object]
 };
 

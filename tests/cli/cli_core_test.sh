@@ -121,6 +121,14 @@ run "$AS" splits generate --out "$TMP/gen"
 expect_rc 0 "splits generate"
 diff -r "$TMP/gen" "$SRC/manifests" >/dev/null && ok || bad "generated manifests differ from the committed ones"
 
+# the raw-Bullet limit: the same world stepped with the recorded controller inputs ends in the same state
+run "$AS" bench env --task pick_cube --raw-bullet --steps 60 --json
+expect_rc 0 "bench env --raw-bullet"
+expect_out '"identical":true' "raw-bullet replay is bit-identical"
+expect_out '"steps":60,"episodes":2' "raw-bullet steps and episodes"
+run "$AS" bench env --task pick_cube --raw-bullet --steps 0
+expect_rc 2 "bench env --raw-bullet --steps 0"
+
 # usage errors are exit 2
 run "$AS" frobnicate
 expect_rc 2 "unknown subcommand"

@@ -3,6 +3,8 @@
 #include "physics_world.hpp"
 
 #include "actionshift/core/rng.hpp"
+#include "actionshift/sim/bench.hpp"
+#include "actionshift/sim/env.hpp"
 #include "actionshift/sim/kinematics.hpp"
 
 #include <gtest/gtest.h>
@@ -78,6 +80,72 @@ TEST(PhysicsWorld, GravityCompensationIsExactWithTheArmDrivesSwitchedOff) {
   falling.set_targets(q);
   for (int i = 0; i < 20; ++i) falling.step_control();
   EXPECT_GT((falling.qpos().head<7>() - q.head<7>()).cwiseAbs().maxCoeff(), 0.01);
+}
+
+// the raw-Bullet limit steps the same world with the recorded controller inputs: the states must be
+// the controlled run's bit for bit, and a perturbed input must show (the inputs are really applied)
+void check_replay(const PhysicsConfig& cfg) {
+  const RobotDescription& desc = panda_description();
+  const ArticulationLayout layout(desc);
+  const Eigen::Isometry3d base = Eigen::Translation3d(-0.615, 0, 0) * Eigen::Isometry3d::Identity();
+  PhysicsWorld world(desc, layout, cfg, base, {7, 8});
+  ObjectSpec cube;
+  cube.boxes.push_back({Eigen::Vector3d::Constant(0.02), Eigen::Isometry3d::Identity()});
+  cube.mass = 0.064;
+  cube.position = Eigen::Vector3d(0.0, 0.0, 0.02);
+  Eigen::VectorXd q(9);
+  q << 0, 0.3927, 0, -1.9635, 0, 2.3562, 0.7854, 0.04, 0.04;
+  BulletInputRecorder rec;
+  set_thread_input_recorder(&rec);
+  world.rebuild({cube}, q);
+  ASSERT_EQ(rec.world, &world);
+  Eigen::VectorXd target = q;
+  for (int k = 0; k < 12; ++k) {
+    target(1) += 0.02;  // reach forward and down, close the fingers: the drives and motors all work
+    target(3) += 0.015;
+    target(7) = target(8) = 0.04 - 0.003 * k;
+    world.set_targets(target);
+    world.step_control();
+  }
+  ASSERT_EQ(rec.inputs.size(), 12u * static_cast<std::size_t>(world.inputs_per_control_step()));
+  const Eigen::VectorXd q_end = world.qpos(), v_end = world.qvel();
+  const Eigen::Isometry3d cube_end = world.object_pose(0);
+  EXPECT_GT((q_end - q).cwiseAbs().maxCoeff(), 0.05) << "the arm moved";
+
+  rec.recording = false;
+  world.rebuild({cube}, q);
+  const int stride = world.inputs_per_control_step();
+  for (int k = 0; k < 12; ++k) world.replay_control(rec.inputs.data() + k * stride);
+  EXPECT_TRUE(world.qpos() == q_end);
+  EXPECT_TRUE(world.qvel() == v_end);
+  EXPECT_TRUE(world.object_pose(0).matrix() == cube_end.matrix());
+
+  std::vector<double> perturbed = rec.inputs;
+  const std::size_t arm_entry = cfg.arm_drive == ArmDrive::kImplicitPd ? 3 * 1 : 3 * 1 + 1;  // joint 2's torque or target
+  perturbed[arm_entry] += 1e-3;
+  world.rebuild({cube}, q);
+  for (int k = 0; k < 12; ++k) world.replay_control(perturbed.data() + k * stride);
+  EXPECT_FALSE(world.qpos() == q_end);
+  set_thread_input_recorder(nullptr);
+}
+
+TEST(PhysicsWorld, ReplayWithRecordedInputsReproducesTheControlledRunBitForBit) {
+  check_replay(PhysicsConfig{});  // maniskill: implicit PD torques on the arm
+  PhysicsConfig servo;
+  servo.arm_drive = ArmDrive::kVelocityServo;  // ideal: motors on every joint
+  servo.arm_joint_limits = false;
+  check_replay(servo);
+}
+
+TEST(PhysicsWorld, RawBulletLimitReplaysWholeEpisodesIdentically) {
+  const RawBulletLimit r = measure_raw_bullet(TaskId::kPickCube, 60, 3);
+  EXPECT_EQ(r.steps, 60);
+  EXPECT_EQ(r.episodes, 2);  // pick_cube's horizon is 50
+  EXPECT_TRUE(r.identical);
+  EXPECT_GT(r.env_seconds, 0.0);
+  EXPECT_GT(r.raw_seconds, 0.0);
+  EXPECT_NEAR(r.ratio, r.raw_seconds / r.env_seconds, 1e-12);
+  EXPECT_THROW(measure_raw_bullet(TaskId::kPickCube, 0), std::invalid_argument);
 }
 
 }  // namespace

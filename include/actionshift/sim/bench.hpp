@@ -25,4 +25,20 @@ EnvThroughput measure_env_throughput(TaskId task, long long steps_per_thread, in
                                      std::shared_ptr<const RobotDescription> robot = nullptr,
                                      std::string_view profile = "maniskill");
 
+/// The raw-Bullet limit of the same world: `steps` control steps of scripted grasp-and-lift episodes
+/// (one thread) are timed through Env::step while the inputs the controller hands Bullet are recorded;
+/// each episode is then rebuilt from its seed and the same bodies are stepped with those inputs and
+/// no controller work (no IK, implicit-PD solve, observation, contact forces or checks).
+struct RawBulletLimit {
+  long long steps{0};            ///< control steps in both runs
+  int episodes{0};               ///< episodes (each replayed once)
+  double env_seconds{0.0};       ///< time inside Env::step (the script's actions are outside)
+  double raw_seconds{0.0};       ///< time stepping Bullet with the recorded inputs
+  double ratio{0.0};             ///< raw_seconds / env_seconds: the share of Env::step that is Bullet
+  bool identical{false};         ///< every replayed episode ended in the recorded joint state, bit for bit
+};
+RawBulletLimit measure_raw_bullet(TaskId task, long long steps, std::uint64_t seed = 1,
+                                  std::shared_ptr<const RobotDescription> robot = nullptr,
+                                  std::string_view profile = "maniskill");
+
 }  // namespace actionshift::sim
