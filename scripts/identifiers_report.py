@@ -104,10 +104,17 @@ rep = os.path.join(results, "train", "reproduce.jsonl")
 if os.path.exists(rep):
     lines = [json.loads(l) for l in open(rep) if l.strip()]
     ok = all(l["identical"] for l in lines)
-    print(f"- Reproduction: retraining the seed-20260720 models gives the committed weights byte for byte: "
+    print(f"- Reproduction: retraining from seed 20260720 gives the committed weights byte for byte: "
           f"**{'yes' if ok else 'NO'}** (" + ", ".join(f"{l['kind']} {l['retrained_sha256'][:12]}" for l in lines) + ").")
-print(f"- Wall time at `nice -n 10` on this machine (2 cores shared with other work): training {train_wall} s "
-      f"({len([v for vs in runs.values() for v in vs])} models), end-to-end evaluation {eval_wall} s.\n")
+print(f"- Budget: {len([v for vs in runs.values() for v in vs])} models, each 96 x 4 rollouts of <= 45 steps (about 15,500 "
+      f"simulator steps) + 3000 Adam steps + 48 held-out rollouts; the evaluation 45 jobs x 100 episodes of <= 50 steps. "
+      f"Elapsed at `nice -n 10` on this machine (2 cores shared with five other engineers' builds and runs, load about 12): "
+      f"training {train_wall} s, end-to-end evaluation {eval_wall} s (from the first start to the last finish, up to four "
+      f"of these processes at a time).")
+cpu = os.path.join(results, "train", "cpu.txt")
+if os.path.exists(cpu):
+    print(f"- CPU time of one training run (`/usr/bin/time`, osi, seed 20260720): {open(cpu).read().strip()}.")
+print()
 
 # ---------------------------------------------------------------- field accuracy
 print("## Field accuracy on held-out contracts, against the horizon\n")
@@ -227,14 +234,58 @@ if all(sign45):
     print(f"- **Sign** stays {'near chance' if max(s[0] for s in sign45) < 0.6 else 'above chance'} "
           f"({', '.join(f'{s[0]:.3f}' for s in sign45)} for osi, recurrent_osi, random excitation).")
 print()
+if rank_rnd and rnd45:
+    print(f"Here uniform random excitation reaches rank {rank_rnd[0]:.1f} of 12 within the window, and the permutation accuracy "
+          f"it allows is {rnd45[0]:.3f} against a chance of 0.167: "
+          + ("**the span of the excitation is not what limits this learner**; the estimation is." if rank_rnd[0] >= 11.5 and rnd45[0] < 0.35
+             else "the span is not full or the learner does identify the permutation; see the table.") + "\n")
 print("**Does the argument hold in this simulator?** The rank bound itself is arithmetic and holds wherever the probe "
       "phase is 6 steps. What it does not settle is whether the *extra* directions that pass-through steps add are enough: "
       "once the regressor matrix reaches full rank 12, the linear map is determined in principle, and what remains is "
-      "noise (the calibrated response gains are 0.02–0.04 m per unit command against per-step noise of the same order, "
-      "docs/adapters.md) and the learner's data: a classifier must learn, from 96 contracts, a map from a 168-number "
+      "noise (the calibrated response gains are 0.02–0.04 per unit command against per-step noise from a fifth of that to "
+      "the same order, configs/calibration/maniskill/pick_cube.json) and the learner's data: a classifier must learn, from 96 contracts, a map from a 168-number "
       "window to 720 permutations x 64 sign patterns x 7^6 scales, and the training contracts cover a vanishing fraction "
       "of that product. A belief over the grammar's factorized cells does not need to have seen a contract to score it. "
       "Where our ranks reach 12 and accuracy still stays far from 1, the bottleneck is this estimation problem, not the "
       "span of the excitation; where the expert's correlated actions keep the rank below 12, the argument applies to "
       "passive evidence too. The end-to-end column is the consequence: acting on a contract with any channel wrong "
-      "drives the arm the wrong way, so success needs every pose field right at once (`exact`), which stays near 0.\n")
+      "drives the arm the wrong way, so success needs every pose field right at once (`exact`), which is at most "
+      f"{max(e for vs in runs.values() for v in vs for e in v['heldout']['exact_contract']):.3f} in every table above.\n")
+
+# ---------------------------------------------------------------- differences from the paper
+import struct
+losses = {}
+for kind in ("osi", "probe_osi", "recurrent_osi"):
+    path = os.path.join(ROOT, "configs", "identifiers", f"pick_cube.{kind}.asid")
+    if os.path.exists(path):
+        b = open(path, "rb").read()
+        n = struct.unpack("<I", b[12:16])[0]
+        losses[kind] = json.loads(b[16:16 + n])["training"].get("final_loss")
+print("## Differences from the paper, and what they explain\n")
+print("- **The learners.** The public reference implementation feeds its identifiers engineered UP-OSI features (per-lag "
+      "least-squares response maps, 301 numbers) into heads that are equivariant over (output, raw) channel pairs; ours "
+      "read the raw evidence (a 14 x 12 window, or an Elman cell over the episode) with plain softmax heads, a weaker "
+      "inductive bias at a matched budget. The committed models end training at a summed cross-entropy of "
+      + ", ".join(f"{k} {v:.1f}" for k, v in losses.items() if v is not None)
+      + " against 30.7 for uniform heads: they fit the training contracts only partly. This is the likeliest reason our "
+      "permutation and lag accuracies sit at or near chance where the paper's reach 0.29–0.39 and 0.42–0.92. We did not "
+      "tune the budget or the architecture on these outcomes (the window 14, warmup 8, hidden width 64, 3000 steps and "
+      "lr 1e-3 are the reference's operating points or fixed before any result); a stronger learner is future work and "
+      "would have to be chosen on pilot seeds.")
+cleared = {}
+for kind in ("osi", "probe_osi", "recurrent_osi", "osi_random"):
+    if kind in runs:
+        last = runs[kind][0]["heldout"]["horizons"][-1]
+        cleared[kind] = [(f, field_at(kind, f, last)[0]) for f in FIELDS if field_at(kind, f, last)[0] > MAJORITY[f] + 0.1]
+print("- **Which fields are identified.** At the last horizon, the fields that clear the constant guess by more than 0.1: "
+      + "; ".join(f"{k}: " + (", ".join(f"{f} {a:.3f}" for f, a in v) if v else "none") for k, v in cleared.items())
+      + ". An absolute target telescopes (one excursion per command instead of an accumulation), which a window sees at "
+      "once (the paper's passive identifier also reached 0.94 on it). The gripper has no TCP signature, so whatever "
+      "accuracy it has comes from the backbone's behaviour: the scripted expert acts differently once a grasp fails.")
+print("- **Backbone, simulator, grammar.** The scripted expert instead of the frozen PPO policy, Bullet with the `maniskill` "
+      "fidelity profile instead of ManiSkill, grid scales instead of continuous ones, lags {0, 1, 2, 4} instead of at most 2. "
+      "The held-out set has 12 contracts (48 rollouts), so a field's accuracy moves in coarse steps; the spread over three "
+      "training seeds is shown.")
+print("- **End to end the two agree**: every identifier stays at the no-adaptation floor on every cell, and the promotion "
+      "gate, computed by code, rejects all of them (probe_osi also for a safety regression: its probes and its wrong "
+      "estimates drive the arm out of the workspace more often than no adaptation).")
