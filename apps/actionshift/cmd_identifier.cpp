@@ -4,6 +4,8 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/eval/identifier_train.hpp"
+#include "actionshift/sim/env.hpp"
+#include "actionshift/sim/task.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -28,6 +30,9 @@ int run_train_identifier(const TrainIdentifierCliOptions& o, std::ostream& out, 
   if (o.episodes <= 0) throw InputError("--episodes", std::to_string(o.episodes), "must be positive");
   if (o.train_steps < 0) throw InputError("--train-steps", std::to_string(o.train_steps), "must be nonnegative");
   if (o.max_contracts < 0) throw InputError("--max-contracts", std::to_string(o.max_contracts), "must be nonnegative");
+  if (o.excitation != "expert" && o.excitation != "random") throw InputError("--excitation", o.excitation, "must be expert or random");
+  (void)sim::parse_task(o.task);          // bad input is one line, before anything is printed
+  (void)sim::profile_config(o.profile);
   const std::string path = o.out.empty() ? adapt::identifier_weights_path(o.task, *kind) : o.out;
   std::ostringstream cmd;
   cmd << "actionshift train identifier --kind " << o.kind << " --task " << o.task << " --seed " << o.seed << " --excitation "
