@@ -2,6 +2,7 @@
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
 #include "cmd_bench_adapt.hpp"
+#include "cmd_identifier.hpp"
 #include "cmd_policy.hpp"
 #include "cmd_render.hpp"
 #include "cmd_run.hpp"
@@ -166,7 +167,7 @@ int main(int argc, char** argv) {
   st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
 
   // ---- train bc | gate0 (policy layer)
-  auto* train = app.add_subcommand("train", "Train backbones");
+  auto* train = app.add_subcommand("train", "Train backbones and identifiers");
   train->require_subcommand(1);
   cli::TrainBcOptions train_o;
   auto* bc = train->add_subcommand(
@@ -185,6 +186,30 @@ int main(int argc, char** argv) {
   bc->add_option("--progress", train_o.progress, "auto, bar or lines (one line per iteration) or off, as for run")
       ->capture_default_str();
   bc->callback([&] { action = [&] { return cli::run_train_bc(train_o); }; });
+  cli::TrainIdentifierCliOptions tid_o;
+  auto* tid = train->add_subcommand(
+      "identifier", "Train a learned identifier of the unprivileged tier (docs/identifiers.md): softmax heads per contract\n"
+                    "field over simulator rollouts under the identifier_training manifest's contracts (hash-disjoint from\n"
+                    "every evaluation contract); seeded and deterministic. Prints the held-out field accuracy per horizon\n"
+                    "and writes configs/identifiers/<task>.<kind>.asid (methods osi, probe_osi, recurrent_osi).");
+  tid->add_option("--kind", tid_o.kind, "osi (passive window), probe_osi (6 fixed pulses first) or recurrent_osi (Elman cell)")
+      ->required();
+  tid->add_option("--task", tid_o.task, "Task of the rollouts")->capture_default_str();
+  tid->add_option("--profile", tid_o.profile, "Simulator fidelity profile of the rollouts")->capture_default_str();
+  tid->add_option("--seed", tid_o.seed, "Seed (weights init, rollouts, minibatches)")->capture_default_str();
+  tid->add_option("--excitation", tid_o.excitation,
+                  "expert: the scripted expert passed through (what a passive identifier sees); random: uniform raw\n"
+                  "pose actions in [-0.5, 0.5] (the random-excitation ablation)")
+      ->capture_default_str();
+  tid->add_option("--episodes", tid_o.episodes, "Rollouts per training contract")->capture_default_str();
+  tid->add_option("--train-steps", tid_o.train_steps, "Adam steps")->capture_default_str();
+  tid->add_option("--max-contracts", tid_o.max_contracts, "Use only the first N training and held-out contracts (smoke runs; 0: all)")
+      ->capture_default_str();
+  tid->add_option("--threads", tid_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
+  tid->add_option("--out", tid_o.out, "Weight file (default: configs/identifiers/<task>.<kind>.asid)");
+  tid->add_option("--verdicts", tid_o.verdicts, "Also write the held-out verdicts (field accuracy per horizon) as JSON here");
+  tid->add_flag("--quiet", tid_o.quiet, "No progress lines");
+  tid->callback([&] { action = [&] { return cli::run_train_identifier(tid_o); }; });
   cli::Gate0Options gate0_o;
   auto* gate0 = app.add_subcommand(
       "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"

@@ -1,6 +1,7 @@
 #include "actionshift/adapt/registry.hpp"
 
 #include "actionshift/adapt/grammar_belief.hpp"
+#include "actionshift/adapt/identifier.hpp"
 #include "actionshift/adapt/methods.hpp"
 #include "actionshift/core/error.hpp"
 
@@ -13,11 +14,14 @@ namespace actionshift::adapt {
 
 const std::vector<std::string>& method_names() {
   static const std::vector<std::string> n{"oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes",
-                                          "exact_belief", "grammar_belief", "no_adapt"};
+                                          "exact_belief", "grammar_belief", "osi", "probe_osi", "recurrent_osi",
+                                          "no_adapt"};
   return n;
 }
 
-bool method_needs_pool(const std::string& m) { return m != "oracle" && m != "no_adapt" && m != "grammar_belief"; }
+bool method_needs_pool(const std::string& m) {
+  return m != "oracle" && m != "no_adapt" && m != "grammar_belief" && !parse_identifier_kind(m);
+}
 bool method_needs_calibration(const std::string& m) { return method_needs_pool(m) || m == "grammar_belief"; }
 
 namespace {
@@ -30,6 +34,10 @@ nlohmann::json defaults(const std::string& m) {
             {"hold_rounds", 1},    {"hold_channels", 6}, {"after_probe", "belief"}, {"gripper_channel", false},
             {"scale_correction", false}, {"scale_window", 16}, {"scale_min", 0.4},  {"scale_max", 2.5},
             {"scale_floor", 0.05},  {"reanchor_period", 0}};
+  // the learned identifiers: committed weights by name (configs/identifiers/<weights>.<method>.asid),
+  // 8 steps of evidence before the first estimate; probe_osi sends the 6 fixed pulses of 0.5 first
+  if (m == "osi" || m == "recurrent_osi") return {{"weights", "pick_cube"}, {"warmup", 8}};
+  if (m == "probe_osi") return {{"weights", "pick_cube"}, {"warmup", 8}, {"budget", 6}, {"amplitude", 0.5}};
   nlohmann::json p = {{"budget", 6}, {"amplitude", 0.5}};
   if (m == "entropy_probes" || m == "dualabi") {
     p["calibrated_preview"] = true;
@@ -121,6 +129,9 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   real_in("scale_min", 1e-9, 1.0, "must be finite and in (0, 1]");
   real_in("scale_max", 1.0, 1e9, "must be finite and at least 1");
   real_in("scale_floor", 0.0, 1e9, "must be finite and nonnegative");
+  int_in("warmup", 1, 1000);
+  if (out.contains("weights") && out["weights"].get<std::string>().empty())
+    throw InputError("method " + method, "weights", "must name committed weights or a .asid file");
   return out;
 }
 
@@ -151,6 +162,17 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
       throw InputError("method grammar_belief", "gripper_channel",
                        "the task's calibration has no finger channel (run `actionshift calibrate --gripper-channel`)");
     return std::make_unique<GrammarBeliefAdapter>(*in.model, o);
+  }
+  if (const auto kind = parse_identifier_kind(method)) {  // the network only: never the truth, the pool or a calibration
+    IdentifierOptions o;
+    o.warmup = p.at("warmup").get<int>();
+    if (*kind == IdentifierKind::kProbeOsi) {
+      o.probe_budget = p.at("budget").get<int>();
+      o.probe_amplitude = p.at("amplitude").get<double>();
+      o.freeze = true;  // estimates once, from the window that holds the probes
+    }
+    return std::make_unique<IdentifierAdapter>(
+        load_identifier_cached(identifier_weights_path(p.at("weights").get<std::string>(), *kind), *kind), o);
   }
   if (method == "oracle") {
     if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given only by the runner)");

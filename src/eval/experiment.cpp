@@ -1,5 +1,7 @@
 #include "actionshift/eval/experiment.hpp"
 
+#include "actionshift/adapt/identifier.hpp"
+
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/scale_corrector.hpp"
 #include "actionshift/adapt/response.hpp"
@@ -244,7 +246,8 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
   if (ctx->prototype->sha256() != job.backbone.sha256)
     throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
   ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));
-  if (job.method == "grammar_belief") {  // parameters that need the calibration fail here, before any episode
+  // parameters that need the calibration, and missing or corrupt identifier weights, fail here, before any episode
+  if (job.method == "grammar_belief" || adapt::parse_identifier_kind(job.method)) {
     adapt::MethodInputs in;
     in.model = ctx->response ? &*ctx->response : nullptr;
     adapt::make_adapter(job.method, ctx->params, in);

@@ -18,7 +18,7 @@ expect_out '6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa' "i
 run "$AS" validate "$SRC/manifests"
 expect_rc 0 "validate manifests/"
 expect_out "b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3" "reference9 pool hash"
-expect_out "all checks passed over 10 manifests" "summary line"
+expect_out "all checks passed over 11 manifests" "summary line"
 # built-in copies give the same answer with no files
 run "$AS" validate --quiet
 expect_rc 0 "validate built-ins"

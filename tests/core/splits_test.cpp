@@ -6,6 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 namespace actionshift {
@@ -133,6 +135,42 @@ TEST(Splits, CommittedManifestsEqualTheGeneratorOutputAndPassEveryCheck) {
     for (const auto* list : {&m.train(), &m.test()})
       for (const auto& r : *list) EXPECT_TRUE(grammar::violations(r.contract).empty()) << path;
   }
+}
+
+// The learned identifiers' training contracts (manifests/identifier_training.json) must never be
+// evaluation contracts: no hash in it may occur in any other committed manifest (train, test or
+// pool member), and the validator's cross-manifest check must catch a leaked one.
+TEST(Splits, IdentifierTrainingContractsShareNoHashWithAnyEvaluationManifest) {
+  const std::filesystem::path dir = std::filesystem::path(ACTIONSHIFT_SOURCE_DIR) / "manifests";
+  std::map<std::string, Manifest> by_name;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".json") by_name.emplace(e.path().stem().string(), Manifest::load(e.path().string()));
+  ASSERT_TRUE(by_name.count("identifier_training"));
+  ASSERT_GE(by_name.size(), 11u);
+  const Manifest& id = by_name.at("identifier_training");
+  EXPECT_EQ(id.train().size(), static_cast<std::size_t>(splits::kIdentifierTrainSize));
+  EXPECT_EQ(id.test().size(), static_cast<std::size_t>(splits::kIdentifierHeldOutSize));
+  std::set<std::string> evaluation;
+  for (const auto& [name, m] : by_name)
+    if (name != "identifier_training")
+      for (const auto* list : {&m.train(), &m.test()})
+        for (const auto& r : *list) evaluation.insert(r.contract.sha256());
+  ASSERT_GT(evaluation.size(), 300u);
+  for (const auto* list : {&id.train(), &id.test()})
+    for (const auto& r : *list) EXPECT_EQ(evaluation.count(r.contract.sha256()), 0u) << "training contract " << r.sha256 << " is evaluated";
+  // the whole grammar is drawn: every target, frame and lag occurs
+  std::set<std::string> fields;
+  for (const auto& r : id.train())
+    fields.insert(std::string(to_string(r.contract.target())) + "/" + to_string(r.contract.frame()) + "/" + std::to_string(r.contract.lag()));
+  EXPECT_GE(fields.size(), 12u);
+  expect_all_ok(validate_set(by_name), "committed set");
+  // a leaked evaluation contract is caught by the validator
+  auto train = id.train_contracts();
+  train.push_back(by_name.at("reference_seen").contracts().front());
+  by_name.insert_or_assign("identifier_training", Manifest::split("identifier_training", "identifier_training", id.seed(),
+                                                                  id.description(), id.metadata(), train, id.contracts()));
+  const auto checks = validate_set(by_name);
+  EXPECT_FALSE(find(checks, "identifier_training_disjoint")->ok);
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ def run_episode(env, adapter, seed, steps, intent):
 def test_every_registered_method_builds_and_runs():
     names = actionshift.methods()
     assert set(names) == {"oracle", "no_adapt", "exact_belief", "fixed_probes", "random_probes",
-                          "entropy_probes", "dualabi", "grammar_belief"}
+                          "entropy_probes", "dualabi", "grammar_belief", "osi", "probe_osi", "recurrent_osi"}
     truth = actionshift.load_manifest("reference9").contracts[1]
     env = actionshift.make(TASK, contract=truth)
     intent = np.array([0.2, 0.0, -0.1, 0.0, 0.0, 0.0, 1.0])
@@ -39,10 +39,10 @@ def test_every_registered_method_builds_and_runs():
         a = adapter_for(method, truth)
         assert a.name == method
         _, probes = run_episode(env, a, seed=3, steps=8, intent=intent)
-        expected_probes = {"fixed_probes": 6, "random_probes": 6, "entropy_probes": 6}.get(method)
+        expected_probes = {"fixed_probes": 6, "random_probes": 6, "entropy_probes": 6, "probe_osi": 6}.get(method)
         if expected_probes is not None:
             assert probes == expected_probes, method
-        elif method in ("oracle", "no_adapt", "exact_belief", "grammar_belief"):
+        elif method in ("oracle", "no_adapt", "exact_belief", "grammar_belief", "osi", "recurrent_osi"):
             assert probes == 0, method
 
 

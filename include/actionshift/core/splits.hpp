@@ -19,6 +19,8 @@ inline constexpr int kTestSize = 32;     ///< evaluation contracts per generated
 inline constexpr int kTrainSize = 64;    ///< training contracts per generated split (32 for unseen_composition)
 inline constexpr int kFullPoolSize = 180;  ///< identity + 5 × 32 split contracts + 19 distractors
 inline constexpr std::array<double, 2> kHeldOutScales{0.5, 2.0};  ///< unseen_value's held-out scale values
+inline constexpr int kIdentifierTrainSize = 96;    ///< identifier_training: contracts the identifiers are trained on
+inline constexpr int kIdentifierHeldOutSize = 12;  ///< identifier_training: held-out contracts for field accuracy
 
 /// Generated splits, in the order the full pool lists them.
 inline const std::vector<std::string>& generated_split_rules() {
@@ -36,6 +38,14 @@ inline std::vector<std::string> all_rules() {
   for (const auto& s : reference_split_rules()) r.push_back(s);
   r.push_back("reference9");
   r.push_back("full");
+  r.push_back("identifier_training");
+  return r;
+}
+
+/// The rules whose contracts are evaluated (every rule but the identifiers' training distribution).
+inline std::vector<std::string> evaluation_rules() {
+  std::vector<std::string> r = all_rules();
+  r.erase(std::find(r.begin(), r.end(), "identifier_training"));
   return r;
 }
 
@@ -239,6 +249,32 @@ inline Manifest generate(const std::string& rule, std::uint64_t seed = kDefaultS
                           "identity, every test contract of the five generated splits (in split order), then "
                           "distractors drawn from the whole grammar",
                           {{"distractors", n_distractors}}, members);
+  }
+  if (rule == "identifier_training") {
+    // the learned identifiers' training distribution (the public reference implementation's
+    // training-contract sampler, on the grammar grids): every field uniform over the whole grammar,
+    // hash-rejected against every contract of every other manifest generated with the same seed
+    // (train, test and pool members), so no identifier is ever trained on a contract it is evaluated on
+    std::set<std::string> excluded;
+    for (const auto& r : evaluation_rules()) {
+      const Manifest m = generate(r, seed);
+      for (const auto* list : {&m.train(), &m.test()})
+        for (const auto& rec : *list) excluded.insert(rec.sha256);
+    }
+    SamplerSpec s;
+    s.targets = {"delta", "absolute"};
+    s.frames = {"base", "tool"};
+    s.lags = {0, 1, 2, 4};
+    auto gen = [&](Rng& r) { return grammar::sample(s, r); };
+    auto train = detail::draw(kIdentifierTrainSize, rng, gen, any, excluded);
+    auto held_out = detail::draw(kIdentifierHeldOutSize, rng, gen, any, excluded);
+    detail::sort_by_hash(train);
+    detail::sort_by_hash(held_out);
+    return Manifest::split("identifier_training", rule, seed,
+                           "training contracts of the learned identifiers (train) and held-out contracts for their field "
+                           "accuracy (test): every field uniform over the grammar grids, hash-rejected against every "
+                           "contract of every other manifest of the same seed",
+                           {{"excluded_rules", evaluation_rules()}}, train, held_out);
   }
   throw std::invalid_argument("unknown split rule: " + rule);
 }

@@ -184,6 +184,25 @@ inline std::vector<Check> validate_set(const std::map<std::string, Manifest>& by
   };
   pool_has("full", splits::generated_split_rules());
   pool_has("reference9", splits::reference_split_rules());
+  // the identifiers' training contracts share no hash with any contract of any other manifest
+  if (auto it = by_name.find("identifier_training"); it != by_name.end()) {
+    std::set<std::string> other;
+    for (const auto& [name, m] : by_name)
+      if (name != "identifier_training")
+        for (const auto* list : {&m.train(), &m.test()})
+          for (const auto& r : *list) other.insert(r.contract.sha256());
+    std::string bad;
+    std::size_t n = 0;
+    for (const auto* list : {&it->second.train(), &it->second.test()})
+      for (const auto& r : *list) {
+        ++n;
+        if (other.count(r.contract.sha256()) && bad.empty()) bad = "contract " + r.contract.sha256().substr(0, 12) + " is also in another manifest";
+      }
+    out.push_back({"identifier_training_disjoint", bad.empty(),
+                   bad.empty() ? "none of its " + std::to_string(n) + " contracts is in any of the other " +
+                                     std::to_string(by_name.size() - 1) + " manifests"
+                               : bad});
+  }
   return out;
 }
 
