@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace actionshift::cli {
 
@@ -40,24 +41,62 @@ std::optional<eval::PolicyFilesRef> cli_policy_files(const std::vector<std::stri
   return ref;
 }
 
+namespace {
+
+// --obs-noise: a finite sigma in [0, 0.1] (metres / radians), else a one-line InputError
+void check_obs_noise(double sigma) {
+  if (!(sigma >= 0.0 && sigma <= sim::kMaxObsNoise)) {  // also rejects NaN
+    std::ostringstream got;
+    got << sigma;
+    throw InputError("command line", "--obs-noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
+  }
+}
+
+// --calibration FILE: a response calibration JSON (as `calibrate --out` writes)
+adapt::ResponseCalibration load_calibration_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  if (!in || !std::filesystem::is_regular_file(path, ec)) throw InputError(path, "--calibration", "cannot read file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return adapt::ResponseCalibration::from_json(text.str(), path);
+}
+
+}  // namespace
+
 int run_run(const RunCliOptions& o) {
   eval::EpisodeFnOptions options;
   options.external.step_timeout_s = o.run.step_timeout_s;
-  const EpisodeFnFactory factory = [options](const eval::JobSpec& job) { return eval::make_episode_fn(job, options); };
   if (!o.run.plan_file.empty()) {
-    if (!o.robot.urdf.empty() || !o.robot.packages.empty() || !o.policy_files.empty()) {
+    const EpisodeFnFactory factory = [options](const eval::JobSpec& job) { return eval::make_episode_fn(job, options); };
+    if (!o.robot.urdf.empty() || !o.robot.packages.empty() || !o.policy_files.empty() || !o.calibration.empty() ||
+        o.request.obs_noise != 0.0) {
       std::cerr << "actionshift: error: --plan: " << o.run.plan_file
-                << ": a plan's jobs carry their robot and policy files; give --robot/--policy-files to `actionshift plan`\n";
+                << ": a plan's jobs carry their robot and policy files (give --robot/--policy-files to `actionshift plan`);"
+                   " --calibration and --obs-noise apply to a single job only\n";
       return kBadInput;
     }
     return run_plan_jobs(o.run, factory);
   }
   try {
+    check_obs_noise(o.request.obs_noise);
     eval::JobRequest q = o.request;
     q.method.params = o.method_params;
     eval::JobSpec job = eval::resolve_job(q, eval::default_resolver());
     job.robot = cli_robot_ref(o.robot);
     job.policy_files = cli_policy_files(o.policy_files, job.backbone.name);
+    if (!o.calibration.empty()) {
+      if (!job.calibration_sha256)
+        throw InputError("command line", "--calibration", "method " + job.method + " uses no response calibration");
+      adapt::ResponseCalibration cal = load_calibration_file(o.calibration);
+      if (cal.task != job.task) throw InputError(o.calibration, "task", "is " + cal.task + ", not the job's " + job.task);
+      const std::string base = cal.profile.substr(0, cal.profile.find('['));
+      if (base != job.profile)
+        throw InputError(o.calibration, "profile", "was measured on " + cal.profile + ", not on the job's profile " + job.profile);
+      job.calibration_sha256 = cal.sha256();
+      options.calibration = std::move(cal);
+    }
+    const EpisodeFnFactory factory = [options](const eval::JobSpec& j) { return eval::make_episode_fn(j, options); };
     return run_one_job(job, o.run, factory);
   } catch (const std::exception& e) {
     std::cerr << "actionshift: error: " << e.what() << "\n";
@@ -108,6 +147,13 @@ int run_calibrate(const CalibrateOptions& o) {
     if (o.joint_limits != "on" && o.joint_limits != "off") throw InputError("", "--joint-limits", "expected on or off");
     cfg.physics.arm_joint_limits = o.joint_limits == "on";
     note("joint_limits", o.joint_limits);
+  }
+  check_obs_noise(o.obs_noise);
+  if (o.obs_noise != 0.0) {
+    std::ostringstream s;
+    s << o.obs_noise;
+    note("obs_noise", s.str());
+    cfg.obs_noise = o.obs_noise;
   }
   if (!overrides.empty()) cfg.profile += "[" + overrides + "]";
   const auto robot = load_cli_robot(o.robot);

@@ -22,6 +22,7 @@ struct RunCliOptions {
   RunPlanOptions run;              // plan_file, job_index, out_dir, threads, fsync, progress
   RobotOptions robot;              // --robot/--package (single job; a plan carries its own)
   std::vector<std::string> policy_files;  // --policy-files: files of an external policy (content hashed into the id)
+  std::string calibration;         // --calibration: response calibration file instead of the built-in one
 };
 int run_run(const RunCliOptions& o);
 
@@ -54,6 +55,7 @@ struct CalibrateOptions {
   bool json{false};  // print the calibration JSON instead of the table
   RobotOptions robot;  // --robot/--package
   bool gripper_channel{false};  // also fit the finger channel (optional "gripper" key)
+  double obs_noise{0.0};        // --obs-noise: observation-noise sigma (label "[obs_noise=S]" on the profile)
 };
 int run_calibrate(const CalibrateOptions& o);
 

@@ -267,6 +267,14 @@ int main(int argc, char** argv) {
                   "Simulator fidelity profile: maniskill (one-step IK, PD drives with inertia, as ManiSkill) or\n"
                   "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")
       ->capture_default_str();
+  run->add_option("--obs-noise", run_o.request.obs_noise,
+                  "Observation (sensor) noise, OFF by default: sigma of Gaussian noise on the observed TCP pose, in\n"
+                  "metres per position coordinate and radians per rotation-vector component (0..0.1), drawn per\n"
+                  "episode; seen by policy and adapter alike; part of the job id when non-zero (docs/sim.md 6.1)")
+      ->capture_default_str();
+  run->add_option("--calibration", run_o.calibration,
+                  "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
+                  "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");
   run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
   run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)");
   run->add_option("--out", run_o.run.out_dir, "Results directory")->capture_default_str();
@@ -380,6 +388,10 @@ int main(int argc, char** argv) {
   calibrate->add_option("--solver-iterations", cal_o.solver_iterations, "Ablation: Bullet solver iterations");
   calibrate->add_option("--joint-limits", cal_o.joint_limits, "Ablation: arm joint limit constraints on or off");
   calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
+  calibrate->add_option("--obs-noise", cal_o.obs_noise,
+                        "Measure under observation noise of this sigma (as run --obs-noise; off by default); the\n"
+                        "calibration's profile label gets [obs_noise=S]")
+      ->capture_default_str();
   calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
   add_robot_options(calibrate, cal_o.robot);
@@ -406,6 +418,8 @@ int main(int argc, char** argv) {
   render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");
   render->add_option("--rotation-mode", render_o.request.rotation_mode, "live or identity")->capture_default_str();
   render->add_option("--profile", render_o.request.profile, "Simulator fidelity profile: maniskill or ideal (as for run)")
+      ->capture_default_str();
+  render->add_option("--obs-noise", render_o.request.obs_noise, "Observation-noise sigma of the job (as for run; 0 = off)")
       ->capture_default_str();
   render->add_option("--contract", render_o.contract, "Contract index in the split")->capture_default_str();
   render->add_option("--episode", render_o.episode, "The contract's episode (0 = its first)")->capture_default_str();

@@ -80,6 +80,13 @@ PlanResolver default_resolver() {
 
 namespace {
 
+// the job's environment settings: its fidelity profile plus its observation noise (0: off)
+sim::EnvConfig env_config(const JobSpec& job) {
+  sim::EnvConfig c = sim::profile_config(job.profile);
+  c.obs_noise = job.obs_noise;
+  return c;
+}
+
 struct Worker {
   std::unique_ptr<policy::Policy> policy;
   std::map<std::int64_t, sim::HiddenContractEnv> envs;  // by contract index
@@ -172,17 +179,25 @@ struct Context {
 
 }  // namespace
 
+namespace {
+EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks,
+                           const std::optional<adapt::ResponseCalibration>& given_calibration);
+}  // namespace
+
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) { return make_episode_fn(job, options, EpisodeHooks{}); }
 
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, EpisodeHooks hooks) {
   validate_job(job);
   policy::RegistryOptions registry;
   registry.external = options.external;
-  return make_episode_fn(job, std::shared_ptr<const policy::Policy>(policy::make_policy(job.backbone.name, sim::parse_task(job.task), registry)),
-                         std::move(hooks));
+  return build_episode_fn(job, std::shared_ptr<const policy::Policy>(policy::make_policy(job.backbone.name, sim::parse_task(job.task), registry)),
+                          std::move(hooks), options.calibration);
 }
 
-EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks) {
+namespace {
+
+EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks,
+                           const std::optional<adapt::ResponseCalibration>& given_calibration) {
   validate_job(job);
   if (!backbone) throw InputError("job", "backbone", "no backbone given");
   auto ctx = std::make_shared<Context>();
@@ -202,9 +217,9 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
       throw InputError(job.robot->urdf, "robot.sha256",
                        "the description (URDF or a mesh) changed since the job was made: its hash is " + robot.sha256 +
                            ", the job's " + job.robot->sha256);
-    ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile), robot.description);
+    ctx->model = sim::EnvModel::make(task, env_config(job), robot.description);
   } else {
-    ctx->model = sim::EnvModel::make(task, sim::profile_config(job.profile));
+    ctx->model = sim::EnvModel::make(task, env_config(job));
   }
   ctx->slice = tcp_slice(ctx->model->layout());
   ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
@@ -225,10 +240,14 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
     throw InputError("job", "pool", "method '" + job.method + "' needs a pool (--pool reference9|full|FILE)");
   }
   if (adapt::method_needs_calibration(job.method)) {
-    const auto cal = builtin_calibration(job.task, job.profile);
+    const auto cal = given_calibration ? *given_calibration : builtin_calibration(job.task, job.profile);
     if (!job.calibration_sha256 || *job.calibration_sha256 != cal.sha256())
       throw InputError("job", "calibration_sha256",
-                       "does not match the built-in calibration of " + job.task + " on profile " + job.profile + " (" + cal.sha256() + ")");
+                       given_calibration ? "does not match the given calibration file (" + cal.sha256() + ")"
+                                         : "does not match the built-in calibration of " + job.task + " on profile " + job.profile +
+                                               " (" + cal.sha256() + ")");
+    if (given_calibration && cal.task != job.task)
+      throw InputError("calibration", "task", "is " + cal.task + ", not the job's " + job.task);
     if (cal.slice.position_start != ctx->slice.position_start || cal.slice.quaternion_start != ctx->slice.quaternion_start)
       throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
     ctx->response = cal.model();
@@ -253,6 +272,12 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
     adapt::make_adapter(job.method, ctx->params, in);
   }
   return [ctx](const EpisodeTask& t) { return ctx->run(t); };
+}
+
+}  // namespace
+
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks) {
+  return build_episode_fn(job, std::move(backbone), std::move(hooks), std::nullopt);
 }
 
 }  // namespace actionshift::eval

@@ -4,6 +4,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
+#include "actionshift/sim/env.hpp"
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -85,6 +86,11 @@ void validate_job(const JobSpec& job, const std::string& src) {
   for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
   if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got \"" + job.profile + "\")");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
+  if (!(job.obs_noise >= 0.0 && job.obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
+    std::ostringstream got;
+    got << job.obs_noise;
+    throw InputError(src, "obs_noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
+  }
   if (job.policy_files) {
     check_hash(job.policy_files->sha256, src, "policy_files.sha256");
     if (job.policy_files->paths.empty()) throw InputError(src, "policy_files.paths", "must name at least one file");
@@ -117,6 +123,7 @@ nlohmann::json job_to_json(const JobSpec& job) {
     j["robot"] = {{"sha256", job.robot->sha256}, {"urdf", job.robot->urdf}, {"packages", packages}};
   }
   if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}, {"paths", job.policy_files->paths}};
+  if (job.obs_noise != 0.0) j["obs_noise"] = job.obs_noise;
   return j;
 }
 
@@ -132,6 +139,16 @@ std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_i
 std::string job_id(const JobSpec& job) { return sha256_hex(job_canonical_json(job)); }
 
 JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
+  if (j.is_object() && j.contains("obs_noise")) {  // optional: present only for a noisy environment
+    json rest = j;
+    rest.erase("obs_noise");
+    JobSpec job = job_from_json(rest, src);
+    const json& v = j.at("obs_noise");
+    if (!v.is_number()) throw InputError(src, "obs_noise", "expected a number");
+    job.obs_noise = v.get<double>();
+    validate_job(job, src);
+    return job;
+  }
   if (j.is_object() && j.contains("policy_files")) {  // optional: present only for named policy files
     json rest = j;
     rest.erase("policy_files");

@@ -303,6 +303,7 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.profile = q.profile;
   job.seed = q.seed;
   job.episodes = q.episodes;
+  job.obs_noise = q.obs_noise;
   validate_job(job, "command line");
   return job;
 }

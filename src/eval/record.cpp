@@ -20,7 +20,7 @@ using nlohmann::json;
 const std::set<std::string>& record_keys() {
   static const std::set<std::string> keys = {
       "backbone",       "backbone_sha256", "contract_index",     "contract_sha256", "episode_index",
-      "job_id",         "method",          "probe_displacement", "probe_steps",     "profile",    "return",
+      "job_id",         "method",          "probe_displacement", "probe_steps",     "profile",    "return", "obs_noise",
       "safety_flags",   "schema_version",  "seed",               "split",           "steps",
       "success_at_end", "success_once",    "task",               "provenance"};
   return keys;
@@ -91,6 +91,7 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
                                              std::to_string(r.steps) + ")");
   if (!std::isfinite(r.probe_displacement) || r.probe_displacement < 0.0)
     throw InputError(src, "probe_displacement", "must be finite and >= 0");
+  if (!std::isfinite(r.obs_noise) || r.obs_noise < 0.0) throw InputError(src, "obs_noise", "must be finite and >= 0");
   std::set<std::string> seen;
   for (const auto& f : r.safety_flags) {
     if (!detail::is_token(f)) throw InputError(src, "safety_flags", "expected names of [a-z0-9_.-] (got \"" + f + "\")");
@@ -124,6 +125,7 @@ nlohmann::json to_json(const EpisodeRecord& r) {
   j["backbone"] = r.backbone;
   j["backbone_sha256"] = r.backbone_sha256;
   j["profile"] = r.profile;
+  if (r.obs_noise != 0.0) j["obs_noise"] = r.obs_noise;  // optional: only for a noisy environment
   if (!r.actionshift_version.empty())
     j["provenance"] = {{"actionshift_version", r.actionshift_version},
                        {"git_commit", r.git_commit.empty() ? json(nullptr) : json(r.git_commit)}};
@@ -164,6 +166,7 @@ EpisodeRecord record_from_json(const nlohmann::json& j, const std::string& src) 
   r.backbone = get_string(j, "backbone", src);
   r.backbone_sha256 = get_string(j, "backbone_sha256", src);
   r.profile = get_string(j, "profile", src);
+  if (j.contains("obs_noise")) r.obs_noise = get_number(j, "obs_noise", src);
   if (j.contains("provenance")) {  // optional: absent in records written before it existed
     const json& p = j.at("provenance");
     if (!p.is_object() || !p.contains("actionshift_version") || !p.at("actionshift_version").is_string() ||

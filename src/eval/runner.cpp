@@ -115,6 +115,7 @@ void stamp_record(EpisodeRecord& r, const JobSpec& job, const std::string& job_i
   r.backbone = job.backbone.name;
   r.backbone_sha256 = job.backbone.sha256;
   r.profile = job.profile;
+  r.obs_noise = job.obs_noise;
   r.actionshift_version = build_provenance().version;
   r.git_commit = build_provenance().git_commit;
 }

@@ -64,6 +64,7 @@ void check_record_belongs(const EpisodeRecord& r, const JobSpec& job, const std:
   if (r.backbone != job.backbone.name) differs("backbone", r.backbone, job.backbone.name);
   if (r.backbone_sha256 != job.backbone.sha256) differs("backbone_sha256", r.backbone_sha256, job.backbone.sha256);
   if (r.profile != job.profile) differs("profile", r.profile, job.profile);
+  if (r.obs_noise != job.obs_noise) differs("obs_noise", std::to_string(r.obs_noise), std::to_string(job.obs_noise));
   const auto slot = episode_slot(job.split.contracts, episode_index);
   if (r.contract_index != slot.contract_index)
     throw InputError(src, "contract_index", "expected " + std::to_string(slot.contract_index) + " for episode " +

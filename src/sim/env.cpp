@@ -2,6 +2,7 @@
 #include "actionshift/sim/env.hpp"
 
 #include "actionshift/core/rng.hpp"
+#include "obs_noise.hpp"
 #include "physics_world.hpp"
 
 #include <algorithm>
@@ -35,6 +36,7 @@ struct EnvImpl {
   // scratch
   Eigen::VectorXd targets;
   Eigen::VectorXd obs_scratch;
+  Rng obs_noise;  // this episode's observation-noise stream (EnvConfig::obs_noise)
 };
 
 }  // namespace detail
@@ -102,6 +104,8 @@ std::shared_ptr<const EnvModel> EnvModel::make(TaskId task, const EnvConfig& con
   std::shared_ptr<EnvModel> m(new EnvModel());
   m->task_ = task;
   m->config_ = config;
+  if (!(config.obs_noise >= 0.0 && config.obs_noise <= kMaxObsNoise))  // also rejects NaN
+    throw std::invalid_argument("obs_noise must be a finite sigma in [0, 0.1] (metres / radians)");
   m->robot_ = robot ? std::move(robot) : std::shared_ptr<const RobotDescription>(&panda_description(), [](const RobotDescription*) {});
   const RobotDescription& desc = *m->robot_;
   m->arm_ = KinematicChain(desc, config.names.tcp_link);
@@ -367,6 +371,8 @@ const Eigen::VectorXd& Env::reset(std::uint64_t seed) {
   e.last = StepResult{};
   const TaskSnapshot s = snapshot();
   compose_obs(m.task(), s, e, e.last.obs);
+  e.obs_noise = Rng(derive_seed({seed, detail::kObsNoiseStream}));
+  detail::apply_obs_noise(m.layout(), m.config().obs_noise, e.obs_noise, e.last.obs);
   const TaskEvaluation ev = evaluate_task(m.task(), s);
   e.last.success = ev.success;
   e.last.reward = ev.reward;
@@ -420,6 +426,7 @@ const StepResult& Env::step(std::span<const double> a) {
   if (unstable) return end_with(SafetyFlag::kUnstableState);
 
   compose_obs(m.task(), s, e, e.last.obs);
+  detail::apply_obs_noise(m.layout(), m.config().obs_noise, e.obs_noise, e.last.obs);
   const TaskEvaluation ev = evaluate_task(m.task(), s);
   e.last.success = ev.success;
   e.last.terminated = ev.success;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <functional>
 #include <set>
 
@@ -130,6 +131,33 @@ TEST(JobSpec, ValidationNamesTheField) {
   nlohmann::json j = job_to_json(golden_job());
   j["extra"] = 1;
   EXPECT_THAT([&] { job_from_json(j, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: extra: unknown field")));
+}
+
+TEST(JobSpec, ObsNoiseEntersTheSpecAndTheIdOnlyWhenNonZero) {
+  JobSpec j = golden_job();
+  j.obs_noise = 0.0;  // off: the spec, its canonical text and its id are those of every earlier job
+  EXPECT_FALSE(job_to_json(j).contains("obs_noise"));
+  EXPECT_EQ(job_id(j), "f0052a82b78ea3758c53f716282ca843abb666b8acdb64ec835a8b69d3c6b5dd");
+  j.obs_noise = 0.005;
+  EXPECT_THAT(job_canonical_json(j), HasSubstr("\"obs_noise\":0.005,"));
+  EXPECT_NE(job_id(j), job_id(golden_job()));
+  JobSpec k = j;
+  k.obs_noise = 0.01;
+  EXPECT_NE(job_id(k), job_id(j));
+  const JobSpec back = job_from_json(job_to_json(j), "plan.json");
+  EXPECT_EQ(back, j);
+  EXPECT_EQ(job_id(back), job_id(j));
+  for (double bad : {-0.001, std::nan(""), HUGE_VAL, 0.2}) {
+    JobSpec b = golden_job();
+    b.obs_noise = bad;
+    EXPECT_THAT([&] { validate_job(b, "cli"); }, ThrowsMessage<InputError>(HasSubstr("cli: obs_noise: must be a finite sigma in [0, 0.1]")))
+        << bad;
+  }
+  nlohmann::json text = job_to_json(j);
+  text["obs_noise"] = "5mm";
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: obs_noise: expected a number")));
+  text["obs_noise"] = -1.0;
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: obs_noise: must be")));
 }
 
 TEST(JobSpec, FileNamesUseTheFullId) {

@@ -105,6 +105,17 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
               ThrowsMessage<InputError>(HasSubstr("expected a JSON object per line")));
 }
 
+TEST(EpisodeRecord, ObsNoiseIsWrittenOnlyWhenNonZero) {
+  EXPECT_EQ(to_jsonl_line(sample_record()).find("obs_noise"), std::string::npos);
+  EpisodeRecord r = sample_record();
+  r.obs_noise = 0.002;
+  const std::string line = to_jsonl_line(r);
+  EXPECT_THAT(line, HasSubstr("\"obs_noise\":0.002,"));
+  EXPECT_EQ(parse_record_line(line, "x.jsonl:1"), r);
+  r.obs_noise = -0.002;
+  EXPECT_THROW(to_jsonl_line(r), InputError);
+}
+
 TEST(EpisodeRecord, RefusesToSerialiseInvalidValues) {
   auto r = sample_record();
   r.task_return = std::nan("");

@@ -39,6 +39,10 @@ std::string resolved_method_params(const std::string& method, const std::string&
 /// Run-time options of an episode function that do not change results (and so stay out of the job id).
 struct EpisodeFnOptions {
   policy::ExternalOptions external;  ///< timeouts of an external:<command> backbone (run --step-timeout)
+  /// The response calibration of a method that needs one, instead of the task's built-in one (run
+  /// --calibration FILE, e.g. one measured under the job's observation noise). Its hash is already
+  /// the job's calibration_sha256 (checked: a mismatch is an InputError), so it changes nothing the id does not name.
+  std::optional<adapt::ResponseCalibration> calibration;
 };
 
 /// The episode function of `job`. Resolves every name and checks that the split manifest hash, pool

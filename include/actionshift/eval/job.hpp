@@ -89,6 +89,9 @@ struct JobSpec {
   std::int64_t episodes{0};                  ///< number of episodes (> 0)
   std::optional<RobotRef> robot;             ///< robot description; none = the embedded Panda
   std::optional<PolicyFilesRef> policy_files;  ///< files of an external policy, or none
+  /// Observation (sensor) noise sigma of the environment (sim::EnvConfig::obs_noise, docs/sim.md §6.1):
+  /// 0 (default, off) or in (0, 0.1]. Hashed and recorded only when non-zero, so ids of jobs without noise are unchanged.
+  double obs_noise{0.0};
   bool operator==(const JobSpec&) const = default;
 };
 
@@ -98,8 +101,8 @@ void validate_job(const JobSpec& job, const std::string& source = "job");
 /// The hashed object: {"backbone":{"name","sha256"},"calibration_sha256","episodes",
 /// "method":{"name","params"},"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
 /// "seed","split":{"contracts","name","sha256"},"task"}, plus "robot":{"packages","sha256","urdf"}
-/// only when the job names a robot, and "policy_files":{"paths","sha256"} only when it names policy
-/// files. Validates first.
+/// only when the job names a robot, "policy_files":{"paths","sha256"} only when it names policy
+/// files, and "obs_noise" (a float) only when it is non-zero. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 
 /// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"} (paths are

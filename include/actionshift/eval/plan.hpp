@@ -82,6 +82,7 @@ struct JobRequest {
   std::string profile{"maniskill"};   ///< simulator fidelity profile
   std::uint64_t seed{20260718};       ///< experimental seed
   std::int64_t episodes{256};         ///< episodes
+  double obs_noise{0.0};              ///< observation-noise sigma (run/render --obs-noise; 0 = off)
 };
 
 /// Resolve a request into a validated JobSpec with the same resolver `plan` uses, so a job run from

@@ -36,6 +36,7 @@ struct EpisodeRecord {
   std::string backbone;         ///< backbone (frozen policy) name
   std::string backbone_sha256;  ///< 64-hex hash of the backbone's weights or description
   std::string profile{"maniskill"};  ///< simulator fidelity profile of the job ("maniskill", "ideal")
+  double obs_noise{0.0};            ///< the job's observation-noise sigma (key `obs_noise` written only when non-zero)
   std::string actionshift_version;  ///< provenance: version of the build that wrote the record ("" → no `provenance` key)
   std::string git_commit;           ///< provenance: its configure-time git commit ("" → null)
 

@@ -65,6 +65,9 @@ struct RobotNames {
 /// The fidelity profile of the default EnvConfig.
 inline constexpr std::string_view kDefaultProfile = "maniskill";
 
+/// Largest accepted EnvConfig::obs_noise (metres / radians): 10 cm of sensor noise is no sensor.
+inline constexpr double kMaxObsNoise = 0.1;
+
 /// Settings of an environment model. The defaults are the `maniskill` fidelity profile.
 struct EnvConfig {
   std::string profile{kDefaultProfile};       ///< name of the fidelity profile these settings came from (recorded, hashed by jobs)
@@ -77,6 +80,12 @@ struct EnvConfig {
   double max_object_speed{50.0};              ///< [m/s]; above: unstable_state
   Eigen::Vector3d robot_base{-0.615, 0.0, 0.0};  ///< robot base position in the world (identity orientation)
   RobotNames names;
+  /// Observation (sensor) noise, OFF by default (docs/sim.md §6.1): sigma of zero-mean Gaussian noise
+  /// on the observed TCP pose, metres on each position coordinate and the same number in radians on
+  /// each component of a world-frame rotation vector turning the orientation; the tcp_to_* fields
+  /// follow the noisy position. Drawn per episode from derive_seed({reset seed, stream tag}), a stream
+  /// nothing else uses; the simulated state, task, reward and safety checks stay exact. 0 <= sigma <= kMaxObsNoise.
+  double obs_noise{0.0};
 };
 
 /// Names of the fidelity profiles, default first: "maniskill", "ideal".
