@@ -5,11 +5,13 @@ splits, through oracle-encode and the exact belief, pooled over the seeds, with 
 reactive (the paper's Table 4), the paired difference (bootstrap over episodes paired by seed and episode
 index: the same initial state and contract), and the lag-4 contracts on their own (from the split manifest).
 Standard library only.
-usage: scripts/long_lag_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS THREADS > docs/results/long_lag.md"""
-import glob, json, math, os, random, subprocess, sys
+usage: scripts/long_lag_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS THREADS [CPU] > docs/results/long_lag.md
+(CPU: the `times` line of the runs, e.g. "2m19.630s 0m10.540s")"""
+import glob, json, math, os, re, random, subprocess, sys
 from collections import defaultdict
 
 results, binary, wall, threads = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+CPU = sys.argv[5] if len(sys.argv) > 5 else ""
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
 # the paper's Table 4 (delay-aware augmented-state PPO vs the frozen reactive PPO, 3 seeds, 600 episodes)
@@ -17,6 +19,12 @@ PAPER = {("pick_cube", "oracle"): (0.528, 0.027), ("push_cube", "oracle"): (0.41
          ("pick_cube", "exact_belief"): (0.360, 0.022), ("push_cube", "exact_belief"): (0.387, 0.117)}
 PAIRS = [("expert", "expert-delay-aware"), ("mlp", "mlp-delay-aware")]
 METHOD_NAME = {"oracle": "oracle-encode", "exact_belief": "exact-belief"}
+
+
+def cpu_text(times_line):
+    """' , CPU time N s' from a bash `times` line ("2m19.630s 0m10.540s"), or '' when not given."""
+    t = re.findall(r"(\d+)m([\d.]+)s", times_line)
+    return "" if not t else f", CPU time {sum(int(m) * 60 + float(x) for m, x in t):.0f} s (user + system)"
 
 
 def wilson(k, n, z=1.959963984540054):
@@ -99,8 +107,8 @@ print("predictor over its own actions) and `mlp-delay-aware` (an MLP with the la
 print("its input, DAgger-trained under a lag drawn from {0, 1, 2, 4}); the paper's is a delay-aware augmented-state")
 print("PPO (observation + last four canonical actions, the same lag distribution). Their reactive counterparts are")
 print("`expert` and `mlp`. The paper's 'frozen ref' column is its reactive PPO.\n")
-print(f"- Command: `scripts/long_lag {results}` (THREADS={threads}, `nice -n 10`); {len(specs)} jobs, {total:,} episodes;"
-      f" wall time {int(float(wall))} s on {threads} thread(s) of a shared 2-core machine.")
+print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} nice -n 10 scripts/long_lag {results}`; {len(specs)} jobs, {total:,} episodes;"
+      f" wall time {int(float(wall))} s on {threads} thread(s) of a shared 2-core machine (load average 12-22){cpu_text(CPU)}.")
 print(f"- Simulator profile **{', '.join(profiles)}** (docs/sim.md); seeds {', '.join(map(str, seeds))};"
       f" {', '.join(map(str, eps))} episodes per (task, split, backbone, method, seed), dealt round-robin over the split's contracts.")
 print("- Splits: `reference_long_lag` (the paper's two long-lag contracts, lags 2 and 4; exact belief over the")
