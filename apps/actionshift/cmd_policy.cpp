@@ -6,12 +6,15 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/policy/gate0.hpp"
+#include "actionshift/policy/ppo.hpp"
 #include "actionshift/policy/registry.hpp"
 #include "actionshift/policy/train.hpp"
 #include "actionshift/sim/robot_source.hpp"
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -85,6 +88,156 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     const std::string bytes = policy::serialize_mlp(result.weights);
     out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.weights.parameter_count()
         << " parameters, sha256 " << sha256_hex(bytes) << ") in " << fmt(result.wall_seconds, 1) << " s\n";
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    err << "actionshift: error: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+namespace {
+std::vector<int> parse_hidden(const std::string& text) {
+  std::vector<int> widths;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || item.empty() || v <= 0 || v > 4096)
+      throw InputError("", "hidden", "expected comma-separated layer widths in [1, 4096] (got '" + text + "')");
+    widths.push_back(v);
+  }
+  if (widths.empty()) throw InputError("", "hidden", "at least one hidden layer is required");
+  return widths;
+}
+}  // namespace
+
+int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err) {
+  try {
+    policy::PpoOptions p;
+    p.task = sim::parse_task(o.task);
+    (void)sim::profile_config(o.profile);  // validates the name
+    p.profile = o.profile;
+    p.seed = o.seed;
+    p.hidden = parse_hidden(o.hidden);
+    if (o.total_steps <= 0) throw InputError("", "total-steps", "must be positive");
+    if (o.envs <= 0 || o.envs > 4096) throw InputError("", "envs", "must be in [1, 4096]");
+    if (o.rollout_steps <= 0) throw InputError("", "rollout-steps", "must be positive");
+    if (o.minibatches <= 0 || static_cast<std::int64_t>(o.envs) * o.rollout_steps < o.minibatches)
+      throw InputError("", "minibatches", "must be positive and at most envs x rollout-steps");
+    if (o.epochs <= 0) throw InputError("", "epochs", "must be positive");
+    if (!(o.learning_rate > 0) || !std::isfinite(o.learning_rate)) throw InputError("", "lr", "must be positive");
+    if (!(o.gamma >= 0 && o.gamma <= 1)) throw InputError("", "gamma", "must be in [0, 1]");
+    if (!(o.gae_lambda >= 0 && o.gae_lambda <= 1)) throw InputError("", "gae-lambda", "must be in [0, 1]");
+    if (o.eval_every < 0 || o.eval_episodes < 0) throw InputError("", "eval-every", "--eval-every and --eval-episodes must be non-negative");
+    p.total_steps = o.total_steps;
+    p.num_envs = o.envs;
+    p.num_steps = o.rollout_steps;
+    p.num_minibatches = o.minibatches;
+    p.update_epochs = o.epochs;
+    p.learning_rate = o.learning_rate;
+    p.gamma = o.gamma;
+    p.gae_lambda = o.gae_lambda;
+    p.target_kl = o.target_kl;
+    p.eval_every = o.eval_every;
+    p.eval_episodes = o.eval_episodes;
+    p.threads = o.threads;
+    const eval::ProgressMode mode = parse_progress_mode(o.progress);
+    const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
+    const std::string path = o.out.empty() ? policy::mlp_weights_path("ppo", p.task) : o.out;
+    const std::string stem = path.size() > 6 && path.ends_with(".asmlp") ? path.substr(0, path.size() - 6) : path;
+    const std::string curve_path = o.curve.empty() ? stem + ".curve.jsonl" : o.curve;
+    std::ofstream curve(curve_path, std::ios::trunc);
+    if (!curve) throw InputError(curve_path, "", "cannot write the training curve");
+    // the command that reproduces a run of `steps` environment steps (a checkpoint names its own)
+    auto command = [&o](std::int64_t steps) {
+      std::ostringstream cmd;
+      cmd << "actionshift train ppo --task " << o.task << " --profile " << o.profile << " --seed " << o.seed << " --total-steps "
+          << steps << " --envs " << o.envs << " --rollout-steps " << o.rollout_steps << " --minibatches " << o.minibatches
+          << " --epochs " << o.epochs << " --lr " << o.learning_rate << " --gamma " << o.gamma << " --gae-lambda " << o.gae_lambda
+          << " --target-kl " << o.target_kl << " --hidden " << o.hidden << " --eval-every " << o.eval_every
+          << " --eval-episodes " << o.eval_episodes;
+      return cmd.str();
+    };
+    const nlohmann::json provenance = {
+        {"command", command(o.total_steps)},
+        {"seed", o.seed},
+        {"algorithm", "PPO (clipped objective, GAE, Adam), Gaussian actor, state-independent log std; backbone = actor mean"},
+        {"profile", o.profile},
+        {"reward", "normalized_dense"},
+        {"num_envs", o.envs},
+        {"rollout_steps", o.rollout_steps},
+        {"minibatches", o.minibatches},
+        {"epochs", o.epochs},
+        {"learning_rate", o.learning_rate},
+        {"gamma", o.gamma},
+        {"gae_lambda", o.gae_lambda},
+        {"clip_coef", p.clip_coef},
+        {"vf_coef", p.vf_coef},
+        {"ent_coef", p.ent_coef},
+        {"max_grad_norm", p.max_grad_norm},
+        {"target_kl", o.target_kl},
+        {"init_log_std", p.init_log_std}};
+    const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;
+    const std::int64_t iterations = std::max<std::int64_t>(1, o.total_steps / per_iter);
+    err << "train ppo: " << o.task << ", layers " << sim::observation_layout(p.task).size() << "-" << o.hidden << "-7 (actor and critic), "
+        << iterations << " iterations x " << o.envs << " envs x " << o.rollout_steps << " steps = " << iterations * per_iter
+        << " env steps, seed " << o.seed << ", " << policy::resolve_threads(o.threads) << " threads\n";
+    double last_eval = -1.0, last_eval_return = 0.0;
+    auto result = policy::train_ppo(
+        p, provenance,
+        [&](const policy::PpoIteration& it) {
+          if (it.eval_success >= 0) {
+            last_eval = it.eval_success;
+            last_eval_return = it.eval_return;
+          }
+          nlohmann::json line = {{"iteration", it.iteration + 1},
+                                 {"env_steps", it.env_steps},
+                                 {"seconds", it.seconds},
+                                 {"steps_per_second", it.seconds > 0 ? static_cast<double>(it.env_steps) / it.seconds : 0.0},
+                                 {"episodes", it.episodes},
+                                 {"successes", it.successes},
+                                 {"policy_loss", it.policy_loss},
+                                 {"value_loss", it.value_loss},
+                                 {"approx_kl", it.approx_kl},
+                                 {"clip_fraction", it.clip_fraction},
+                                 {"epochs", it.epochs},
+                                 {"mean_std", it.mean_std}};
+          line["mean_return"] = std::isfinite(it.mean_return) ? nlohmann::json(it.mean_return) : nlohmann::json(nullptr);
+          if (it.eval_success >= 0) {
+            line["eval_success_once"] = it.eval_success;
+            line["eval_return"] = it.eval_return;
+          }
+          curve << line.dump() << "\n" << std::flush;
+          if (mode == eval::ProgressMode::off) return;
+          std::ostringstream l;
+          l << "iteration " << it.iteration + 1 << "/" << iterations << ", " << it.env_steps << " steps, "
+            << fmt(it.seconds > 0 ? static_cast<double>(it.env_steps) / it.seconds : 0.0, 0) << " steps/s: train success "
+            << it.successes << "/" << it.episodes << ", return "
+            << (std::isfinite(it.mean_return) ? fmt(it.mean_return, 2) : std::string("-")) << "; eval success "
+            << (last_eval >= 0 ? fmt(last_eval, 3) : std::string("-")) << ", return " << (last_eval >= 0 ? fmt(last_eval_return, 2) : std::string("-"))
+            << "; kl " << fmt(it.approx_kl, 4) << ", std " << fmt(it.mean_std, 3);
+          if (bar)
+            err << "\r\033[K" << l.str() << (it.iteration + 1 == iterations ? "\n" : "") << std::flush;
+          else
+            err << "  " << l.str() << "\n";
+        },
+        [&path, &command](const policy::MlpWeights& w) {
+          policy::MlpWeights c = w;
+          c.training["command"] = command(w.training.at("env_steps").get<std::int64_t>());
+          policy::save_mlp(c, path);
+        });
+    result.actor.training["command"] = command(result.actor.training.at("env_steps").get<std::int64_t>());
+    policy::save_mlp(result.actor, path);
+    const std::string bytes = policy::serialize_mlp(result.actor);
+    out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.actor.parameter_count() << " parameters, sha256 "
+        << sha256_hex(bytes) << ") and " << curve_path << " in " << fmt(result.wall_seconds, 1) << " s; final eval success "
+        << (last_eval >= 0 ? fmt(last_eval, 3) : std::string("-")) << "\n";
     return 0;
   } catch (const std::invalid_argument& e) {
     err << "actionshift: error: " << e.what() << "\n";

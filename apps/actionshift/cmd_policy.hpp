@@ -26,6 +26,31 @@ struct TrainBcOptions {
 };
 int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
+// `actionshift train ppo --task T [--seed S] [--total-steps N] [--envs N] [--rollout-steps N] ...
+//  [--curve FILE] [--out FILE]`
+struct TrainPpoOptions {
+  std::string task;                 // --task
+  std::string profile{"maniskill"}; // --profile
+  std::uint64_t seed{20260718};     // --seed
+  std::int64_t total_steps{1'000'000};  // --total-steps (environment steps)
+  int envs{64};                     // --envs parallel environments
+  int rollout_steps{16};            // --rollout-steps per environment per iteration
+  int minibatches{2};               // --minibatches per epoch
+  int epochs{4};                    // --epochs per update
+  double learning_rate{3e-4};       // --lr
+  double gamma{0.8};                // --gamma
+  double gae_lambda{0.9};           // --gae-lambda
+  double target_kl{0.1};            // --target-kl (<= 0: off)
+  std::string hidden{"256,256,256"};  // --hidden widths, comma separated
+  int eval_every{10};               // --eval-every iterations
+  int eval_episodes{32};            // --eval-episodes
+  unsigned threads{0};              // --threads (0: all cores)
+  std::string out;                  // --out FILE ("" → configs/backbones/<task>.ppo.asmlp)
+  std::string curve;                // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
+  std::string progress{"auto"};     // --progress auto|bar|lines|off
+};
+int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+
 // `actionshift gate0 --backbone B --task T --episodes N [--seed S] [--floor F] [--rule R]
 //  [--threads N] [--json] [--out FILE] [--backbones-dir DIR] [--step-timeout S]`
 struct Gate0Options {

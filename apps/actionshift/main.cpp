@@ -210,6 +210,33 @@ int main(int argc, char** argv) {
   tid->add_option("--verdicts", tid_o.verdicts, "Also write the held-out verdicts (field accuracy per horizon) as JSON here");
   tid->add_flag("--quiet", tid_o.quiet, "No progress lines");
   tid->callback([&] { action = [&] { return cli::run_train_identifier(tid_o); }; });
+  cli::TrainPpoOptions ppo_o;
+  auto* ppo = train->add_subcommand(
+      "ppo", "Train a PPO backbone of a task (clipped objective, GAE, Adam; Gaussian actor-critic MLPs on Eigen,\n"
+             "vectorised rollouts over --envs environments on all cores, the normalized dense reward). Defaults: the\n"
+             "ManiSkill PPO baseline's where they transfer (docs/backbones.md, PPO). Deterministic given the seed,\n"
+             "whatever the thread count. Writes the actor mean as configs/backbones/<task>.ppo.asmlp (backbone\n"
+             "`ppo`; checkpointed after every evaluation) and a training curve, one JSON line per iteration.");
+  ppo->add_option("--task", ppo_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
+  ppo->add_option("--profile", ppo_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->capture_default_str();
+  ppo->add_option("--seed", ppo_o.seed, "Seed (initialisation, episodes, exploration noise, minibatches)")->capture_default_str();
+  ppo->add_option("--total-steps", ppo_o.total_steps, "Environment steps of the run")->capture_default_str();
+  ppo->add_option("--envs", ppo_o.envs, "Parallel environments")->capture_default_str();
+  ppo->add_option("--rollout-steps", ppo_o.rollout_steps, "Steps per environment per iteration")->capture_default_str();
+  ppo->add_option("--minibatches", ppo_o.minibatches, "Minibatches per epoch")->capture_default_str();
+  ppo->add_option("--epochs", ppo_o.epochs, "Epochs per update")->capture_default_str();
+  ppo->add_option("--lr", ppo_o.learning_rate, "Adam learning rate")->capture_default_str();
+  ppo->add_option("--gamma", ppo_o.gamma, "Discount")->capture_default_str();
+  ppo->add_option("--gae-lambda", ppo_o.gae_lambda, "GAE lambda")->capture_default_str();
+  ppo->add_option("--target-kl", ppo_o.target_kl, "Stop an update's epochs above this approximate KL (<= 0: never)")->capture_default_str();
+  ppo->add_option("--hidden", ppo_o.hidden, "Hidden layer widths of actor and critic, comma separated")->capture_default_str();
+  ppo->add_option("--eval-every", ppo_o.eval_every, "Iterations between deterministic evaluations (and checkpoints)")->capture_default_str();
+  ppo->add_option("--eval-episodes", ppo_o.eval_episodes, "Episodes per evaluation (training seed stream)")->capture_default_str();
+  ppo->add_option("--threads", ppo_o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  ppo->add_option("--out", ppo_o.out, "Weight file (default: configs/backbones/<task>.ppo.asmlp)");
+  ppo->add_option("--curve", ppo_o.curve, "Training curve, JSON lines (default: the weight file's name with .curve.jsonl)");
+  ppo->add_option("--progress", ppo_o.progress, "auto, bar (one updating line), lines (one per iteration) or off")->capture_default_str();
+  ppo->callback([&] { action = [&] { return cli::run_train_ppo(ppo_o); }; });
   cli::Gate0Options gate0_o;
   auto* gate0 = app.add_subcommand(
       "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"

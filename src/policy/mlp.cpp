@@ -238,15 +238,15 @@ Action mlp_forward(const MlpWeights& w, const Eigen::Ref<const Eigen::VectorXf>&
   return h.cast<double>().cwiseMax(-1.0).cwiseMin(1.0);
 }
 
-MlpPolicy::MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha256)
-    : weights_(std::move(weights)), sha256_(std::move(sha256)) {
+MlpPolicy::MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha256, std::string name)
+    : weights_(std::move(weights)), sha256_(std::move(sha256)), name_(std::move(name)) {
   input_ = Eigen::VectorXf::Zero(weights_->input_dim());
 }
 
-std::unique_ptr<MlpPolicy> MlpPolicy::from_file(const std::string& path) {
+std::unique_ptr<MlpPolicy> MlpPolicy::from_file(const std::string& path, const std::string& name) {
   const std::string bytes = read_file(path);
   auto w = std::make_shared<const MlpWeights>(parse_mlp(bytes, path));
-  return std::make_unique<MlpPolicy>(std::move(w), sha256_hex(bytes));
+  return std::make_unique<MlpPolicy>(std::move(w), sha256_hex(bytes), name);
 }
 
 void MlpPolicy::reset() { input_.setZero(); }
@@ -266,8 +266,11 @@ Action MlpPolicy::act(const Eigen::Ref<const Eigen::VectorXd>& obs) {
   return a;
 }
 
-std::string MlpPolicy::name() const { return weights_->history > 0 ? "mlp-delay-aware" : "mlp"; }
+std::string MlpPolicy::name() const {
+  if (!name_.empty()) return name_;
+  return weights_->history > 0 ? "mlp-delay-aware" : "mlp";
+}
 
-std::unique_ptr<Policy> MlpPolicy::clone() const { return std::make_unique<MlpPolicy>(weights_, sha256_); }
+std::unique_ptr<Policy> MlpPolicy::clone() const { return std::make_unique<MlpPolicy>(weights_, sha256_, name_); }
 
 }  // namespace actionshift::policy

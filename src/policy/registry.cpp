@@ -24,7 +24,7 @@ std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const 
   return dir + "/" + std::string(sim::task_name(task)) + "." + std::string(backbone) + ".asmlp";
 }
 
-std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware"}; }
+std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo"}; }
 
 std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task, const RegistryOptions& options) {
   if (backbone == "expert") return make_expert(task);
@@ -40,6 +40,14 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
       throw InputError(path, "history", "mlp-delay-aware needs a network with an action history");
     return p;
   }
+  if (backbone == "ppo") {  // the PPO-trained actor (train ppo): an MLP weight file named ppo
+    const std::string path = mlp_weights_path(backbone, task, options.backbones_dir);
+    auto p = MlpPolicy::from_file(path, "ppo");
+    if (p->task() != task)
+      throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
+                                         std::string(sim::task_name(task)));
+    return p;
+  }
   if (backbone.starts_with("external:")) {
     const std::string cmd(backbone.substr(9));
     if (cmd.empty()) throw InputError("", "backbone", "external: needs a command, e.g. external:python3 policy.py");
@@ -47,7 +55,7 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
   }
   throw InputError("", "backbone",
                    "unknown backbone '" + std::string(backbone) +
-                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<path>, external:<command>)");
+                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, mlp:<path>, external:<command>)");
 }
 
 }  // namespace actionshift::policy

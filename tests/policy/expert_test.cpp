@@ -66,8 +66,13 @@ TEST(Expert, HashIdentifiesVersionAndTask) {
 }
 
 TEST(Registry, UnknownBackboneIsAnInputError) {
-  EXPECT_THAT([] { policy::make_policy("ppo", sim::TaskId::kPickCube); },
-              ::testing::ThrowsMessage<InputError>(HasSubstr("unknown backbone 'ppo'")));
+  EXPECT_THAT([] { policy::make_policy("sac", sim::TaskId::kPickCube); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("unknown backbone 'sac'")));
+  // ppo is a known backbone whose weight file must exist (none is committed for pick_cube)
+  policy::RegistryOptions none;
+  none.backbones_dir = "/nonexistent";
+  EXPECT_THAT([&none] { policy::make_policy("ppo", sim::TaskId::kPickCube, none); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("/nonexistent/pick_cube.ppo.asmlp")));
   EXPECT_THAT([] { policy::make_policy("external:", sim::TaskId::kPickCube); },
               ::testing::ThrowsMessage<InputError>(HasSubstr("needs a command")));
 }

@@ -67,14 +67,15 @@ MlpWeights load_mlp(const std::string& path);
 /// Output clipped to [-1, 1].
 Action mlp_forward(const MlpWeights& w, const Eigen::Ref<const Eigen::VectorXf>& x);
 
-/// The MLP as a Policy. Name "mlp" (or "mlp-delay-aware" when history > 0); sha256 = SHA-256 of
-/// the weight file's bytes.
+/// The MLP as a Policy. Name "mlp" (or "mlp-delay-aware" when history > 0) unless the backbone
+/// registry names it otherwise (e.g. "ppo" for a PPO-trained actor); sha256 = SHA-256 of the weight
+/// file's bytes.
 class MlpPolicy final : public Policy {
  public:
-  /// `sha256`: hash of the bytes the weights were loaded from.
-  MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha256);
+  /// `sha256`: hash of the bytes the weights were loaded from; `name`: "" = the default name.
+  MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha256, std::string name = "");
   /// Load from a file (hash = SHA-256 of its bytes).
-  static std::unique_ptr<MlpPolicy> from_file(const std::string& path);
+  static std::unique_ptr<MlpPolicy> from_file(const std::string& path, const std::string& name = "");
 
   void reset() override;
   Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override;
@@ -87,6 +88,7 @@ class MlpPolicy final : public Policy {
  private:
   std::shared_ptr<const MlpWeights> weights_;
   std::string sha256_;
+  std::string name_;       ///< "" = mlp / mlp-delay-aware
   Eigen::VectorXf input_;  ///< obs ++ history (most recent first)
 };
 

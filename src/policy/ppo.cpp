@@ -1,0 +1,487 @@
+// PPO (clipped objective, GAE, Adam) of a Gaussian actor-critic on Eigen, vectorised rollouts
+#include "actionshift/policy/ppo.hpp"
+
+#include "actionshift/core/hash.hpp"
+#include "actionshift/core/rng.hpp"
+#include "actionshift/core/workers.hpp"
+#include "actionshift/policy/rollout.hpp"
+#include "actionshift/sim/env.hpp"
+
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <stdexcept>
+
+namespace actionshift::policy {
+namespace {
+
+constexpr std::uint64_t kPpoStream = 0x7070'6f00'0000'0000ULL;  // keeps PPO seeds apart from evaluation seeds
+constexpr int kGradChunks = 8;  // a minibatch gradient is the ordered sum of this many chunk gradients
+const float kLogSqrt2Pi = static_cast<float>(0.5 * std::log(2.0 * std::numbers::pi));
+
+using Net = PpoLearner::Net;
+
+// orthogonal matrix (rows x cols) scaled by gain, as torch.nn.init.orthogonal_
+Eigen::MatrixXf orthogonal(int rows, int cols, double gain, Rng& rng) {
+  const bool transpose = rows < cols;
+  const int r = transpose ? cols : rows, c = transpose ? rows : cols;
+  Eigen::MatrixXd a(r, c);
+  for (int j = 0; j < c; ++j)
+    for (int i = 0; i < r; ++i) a(i, j) = rng.normal();
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(a);
+  Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(r, c);
+  const Eigen::VectorXd d = qr.matrixQR().diagonal();
+  for (int j = 0; j < c; ++j)
+    if (d(j) < 0) q.col(j) = -q.col(j);
+  Eigen::MatrixXd out = transpose ? Eigen::MatrixXd(q.transpose()) : q;
+  return (gain * out).cast<float>();
+}
+
+Net make_net(const std::vector<int>& sizes, double out_gain, Rng& rng) {
+  Net n;
+  for (std::size_t i = 0; i + 1 < sizes.size(); ++i) {
+    const bool last = i + 2 == sizes.size();
+    n.w.push_back(orthogonal(sizes[i + 1], sizes[i], last ? out_gain : std::sqrt(2.0), rng));
+    n.b.push_back(Eigen::VectorXf::Zero(sizes[i + 1]));
+  }
+  return n;
+}
+
+Net zeros_like(const Net& n) {
+  Net z;
+  for (std::size_t i = 0; i < n.w.size(); ++i) {
+    z.w.push_back(Eigen::MatrixXf::Zero(n.w[i].rows(), n.w[i].cols()));
+    z.b.push_back(Eigen::VectorXf::Zero(n.b[i].size()));
+  }
+  return z;
+}
+
+// act[0] = x, act[i] = tanh(W act[i-1] + b) for hidden layers, act[L] = linear output
+void forward(const Net& n, const Eigen::MatrixXf& x, std::vector<Eigen::MatrixXf>& act) {
+  const std::size_t layers = n.w.size();
+  act.resize(layers + 1);
+  act[0] = x;
+  for (std::size_t i = 0; i < layers; ++i) {
+    Eigen::MatrixXf z = n.w[i] * act[i];
+    z.colwise() += n.b[i];
+    act[i + 1] = i + 1 < layers ? Eigen::MatrixXf(z.array().tanh()) : z;
+  }
+}
+
+// accumulate the parameter gradients of a loss whose gradient w.r.t. the output is delta
+void backward(const Net& n, const std::vector<Eigen::MatrixXf>& act, Eigen::MatrixXf delta, Net& g) {
+  for (std::size_t k = n.w.size(); k-- > 0;) {
+    g.w[k].noalias() += delta * act[k].transpose();
+    g.b[k] += delta.rowwise().sum();
+    if (k > 0) delta = (n.w[k].transpose() * delta).cwiseProduct((1.0f - act[k].array().square()).matrix());
+  }
+}
+
+void add_into(Net& a, const Net& b) {
+  for (std::size_t i = 0; i < a.w.size(); ++i) {
+    a.w[i] += b.w[i];
+    a.b[i] += b.b[i];
+  }
+}
+
+double squared_norm(const Net& n) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < n.w.size(); ++i) s += n.w[i].squaredNorm() + n.b[i].squaredNorm();
+  return s;
+}
+
+void scale(Net& n, float f) {
+  for (std::size_t i = 0; i < n.w.size(); ++i) {
+    n.w[i] *= f;
+    n.b[i] *= f;
+  }
+}
+
+template <class T>
+void adam(T& p, T& m, T& v, const T& g, float lr, float c1, float c2, float eps) {
+  constexpr float b1 = 0.9f, b2 = 0.999f;
+  m = b1 * m + (1 - b1) * g;
+  v = b2 * v + (1 - b2) * g.cwiseProduct(g);
+  p.array() -= (lr / c1) * m.array() / ((v.array() / c2).sqrt() + eps);
+}
+
+void adam_net(Net& p, Net& m, Net& v, const Net& g, float lr, float c1, float c2, float eps) {
+  for (std::size_t i = 0; i < p.w.size(); ++i) {
+    adam(p.w[i], m.w[i], v.w[i], g.w[i], lr, c1, c2, eps);
+    adam(p.b[i], m.b[i], v.b[i], g.b[i], lr, c1, c2, eps);
+  }
+}
+
+// gradient and loss sums of one chunk of a minibatch
+struct ChunkGrad {
+  Net actor, critic;
+  Eigen::VectorXf log_std;
+  double policy_loss{0.0}, value_loss{0.0}, approx_kl{0.0};
+  std::int64_t clipped{0};
+};
+
+std::vector<int> sizes_of(int in, const std::vector<int>& hidden, int out) {
+  std::vector<int> s{in};
+  s.insert(s.end(), hidden.begin(), hidden.end());
+  s.push_back(out);
+  return s;
+}
+
+}  // namespace
+
+Eigen::VectorXf gae(const Eigen::VectorXf& rewards, const Eigen::VectorXf& values, const Eigen::VectorXf& final_values,
+                    const std::vector<std::uint8_t>& ended, const Eigen::VectorXf& next_value, int num_envs, double gamma,
+                    double lambda) {
+  const Eigen::Index n = rewards.size();
+  if (num_envs <= 0 || n % num_envs != 0 || values.size() != n || final_values.size() != n ||
+      static_cast<Eigen::Index>(ended.size()) != n || next_value.size() != num_envs)
+    throw std::invalid_argument("gae: inconsistent sizes");
+  const int steps = static_cast<int>(n / num_envs);
+  const float g = static_cast<float>(gamma), gl = static_cast<float>(gamma * lambda);
+  Eigen::VectorXf adv(n);
+  for (int e = 0; e < num_envs; ++e) {
+    float last = 0.0f;
+    for (int t = steps - 1; t >= 0; --t) {
+      const Eigen::Index k = static_cast<Eigen::Index>(t) * num_envs + e;
+      if (ended[static_cast<std::size_t>(k)]) {
+        last = rewards(k) + g * final_values(k) - values(k);  // episode over: no carry from the next episode
+      } else {
+        const float nv = t == steps - 1 ? next_value(e) : values(k + num_envs);
+        last = rewards(k) + g * nv - values(k) + gl * last;
+      }
+      adv(k) = last;
+    }
+  }
+  return adv;
+}
+
+PpoLearner::PpoLearner(const PpoOptions& options, int obs_dim) : o_(options) {
+  Rng rng(derive_seed({o_.seed, kPpoStream, 0}));
+  actor_ = make_net(sizes_of(obs_dim, o_.hidden, kActionDim), 0.01 * std::sqrt(2.0), rng);
+  critic_ = make_net(sizes_of(obs_dim, o_.hidden, 1), 1.0, rng);
+  log_std_ = Eigen::VectorXf::Constant(kActionDim, static_cast<float>(o_.init_log_std));
+  m_actor_ = zeros_like(actor_);
+  v_actor_ = zeros_like(actor_);
+  m_critic_ = zeros_like(critic_);
+  v_critic_ = zeros_like(critic_);
+  m_log_std_ = v_log_std_ = Eigen::VectorXf::Zero(kActionDim);
+}
+
+Eigen::MatrixXf PpoLearner::mean(const Eigen::MatrixXf& obs) const {
+  std::vector<Eigen::MatrixXf> act;
+  forward(actor_, obs, act);
+  return act.back();
+}
+
+Eigen::VectorXf PpoLearner::value(const Eigen::MatrixXf& obs) const {
+  std::vector<Eigen::MatrixXf> act;
+  forward(critic_, obs, act);
+  return act.back().row(0).transpose();
+}
+
+Eigen::VectorXf PpoLearner::log_prob(const Eigen::MatrixXf& mean, const Eigen::MatrixXf& actions) const {
+  const Eigen::ArrayXf inv_std = (-log_std_).array().exp();
+  const Eigen::ArrayXXf z = (actions - mean).array().colwise() * inv_std;
+  const float c = -log_std_.sum() - kActionDim * kLogSqrt2Pi;
+  return (-0.5f * z.square().colwise().sum() + c).matrix().transpose();
+}
+
+PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_seed, unsigned threads) {
+  const Eigen::Index n = batch.size();
+  const Eigen::Index mb = n / std::max(1, o_.num_minibatches);
+  if (mb < 1) throw std::invalid_argument("PPO update: fewer transitions than minibatches");
+  std::vector<Eigen::Index> idx(static_cast<std::size_t>(n));
+  std::iota(idx.begin(), idx.end(), Eigen::Index{0});
+  Rng rng(shuffle_seed);
+  const float clip = static_cast<float>(o_.clip_coef);
+  PpoUpdateStats stats;
+  const int obs_dim = static_cast<int>(batch.obs.rows());
+  Eigen::MatrixXf x(obs_dim, mb), a(kActionDim, mb);
+  Eigen::VectorXf old_lp(mb), adv(mb), ret(mb);
+  std::vector<ChunkGrad> chunks(kGradChunks);
+  for (int epoch = 0; epoch < o_.update_epochs; ++epoch) {
+    for (std::size_t i = idx.size(); i > 1; --i) std::swap(idx[i - 1], idx[static_cast<std::size_t>(rng.uniform_int(i))]);
+    double pl = 0.0, vl = 0.0, kl = 0.0;
+    std::int64_t clipped = 0, seen = 0;
+    for (Eigen::Index start = 0; start + mb <= n; start += mb) {
+      for (Eigen::Index c = 0; c < mb; ++c) {
+        const Eigen::Index k = idx[static_cast<std::size_t>(start + c)];
+        x.col(c) = batch.obs.col(k);
+        a.col(c) = batch.actions.col(k);
+        old_lp(c) = batch.log_probs(k);
+        adv(c) = batch.advantages(k);
+        ret(c) = batch.returns(k);
+      }
+      // advantage normalisation over the minibatch (unbiased std, as torch)
+      const float am = adv.mean();
+      const float as = mb > 1 ? std::sqrt((adv.array() - am).square().sum() / static_cast<float>(mb - 1)) : 0.0f;
+      const Eigen::VectorXf nadv = (adv.array() - am) / (as + 1e-8f);
+      const float inv_m = 1.0f / static_cast<float>(mb);
+      std::atomic<int> next{0};
+      WorkerPool pool(std::min<unsigned>(resolve_threads(threads), kGradChunks), [&](unsigned) {
+        while (true) {
+          const int ci = next.fetch_add(1);
+          if (ci >= kGradChunks) break;
+          const Eigen::Index c0 = mb * ci / kGradChunks, c1 = mb * (ci + 1) / kGradChunks, m = c1 - c0;
+          ChunkGrad& g = chunks[static_cast<std::size_t>(ci)];
+          g = ChunkGrad{zeros_like(actor_), zeros_like(critic_), Eigen::VectorXf::Zero(kActionDim), 0.0, 0.0, 0.0, 0};
+          if (m == 0) continue;
+          std::vector<Eigen::MatrixXf> act;
+          forward(actor_, x.middleCols(c0, m), act);
+          const Eigen::MatrixXf diff = a.middleCols(c0, m) - act.back();
+          const Eigen::ArrayXf inv_var = (-2.0f * log_std_).array().exp();
+          const Eigen::VectorXf lp = log_prob(act.back(), a.middleCols(c0, m));
+          Eigen::RowVectorXf g_lp(m);
+          for (Eigen::Index j = 0; j < m; ++j) {
+            const float logratio = lp(j) - old_lp(c0 + j);
+            const float ratio = std::exp(logratio);
+            const float A = nadv(c0 + j);
+            const float pg1 = -A * ratio, pg2 = -A * std::clamp(ratio, 1.0f - clip, 1.0f + clip);
+            g.policy_loss += std::max(pg1, pg2);
+            g.approx_kl += (ratio - 1.0f) - logratio;
+            if (std::abs(ratio - 1.0f) > clip) ++g.clipped;
+            g_lp(j) = pg1 >= pg2 ? -A * ratio * inv_m : 0.0f;  // d loss / d log_prob
+          }
+          // d log_prob / d mean = diff / var; d log_prob / d log_std = diff^2 / var - 1
+          const Eigen::MatrixXf dmean = (diff.array().colwise() * inv_var).rowwise() * g_lp.array();
+          g.log_std = (((diff.array().square().colwise() * inv_var) - 1.0f).rowwise() * g_lp.array()).rowwise().sum().matrix();
+          g.log_std.array() -= static_cast<float>(o_.ent_coef) * static_cast<float>(m) * inv_m;  // entropy bonus
+          backward(actor_, act, dmean, g.actor);
+          std::vector<Eigen::MatrixXf> cact;
+          forward(critic_, x.middleCols(c0, m), cact);
+          const Eigen::RowVectorXf dv = cact.back().row(0) - ret.segment(c0, m).transpose();
+          g.value_loss += 0.5 * dv.squaredNorm();
+          backward(critic_, cact, Eigen::MatrixXf(static_cast<float>(o_.vf_coef) * inv_m * dv), g.critic);
+        }
+      });
+      pool.join();
+      ChunkGrad& total = chunks[0];
+      for (int ci = 1; ci < kGradChunks; ++ci) {
+        const ChunkGrad& g = chunks[static_cast<std::size_t>(ci)];
+        add_into(total.actor, g.actor);
+        add_into(total.critic, g.critic);
+        total.log_std += g.log_std;
+        total.policy_loss += g.policy_loss;
+        total.value_loss += g.value_loss;
+        total.approx_kl += g.approx_kl;
+        total.clipped += g.clipped;
+      }
+      // global gradient-norm clipping over every parameter, then Adam
+      const double norm = std::sqrt(squared_norm(total.actor) + squared_norm(total.critic) + total.log_std.squaredNorm());
+      if (o_.max_grad_norm > 0 && norm > o_.max_grad_norm) {
+        const float f = static_cast<float>(o_.max_grad_norm / (norm + 1e-6));
+        scale(total.actor, f);
+        scale(total.critic, f);
+        total.log_std *= f;
+      }
+      ++adam_t_;
+      const float c1 = 1.0f - std::pow(0.9f, static_cast<float>(adam_t_));
+      const float c2 = 1.0f - std::pow(0.999f, static_cast<float>(adam_t_));
+      const float lr = static_cast<float>(o_.learning_rate), eps = static_cast<float>(o_.adam_eps);
+      adam_net(actor_, m_actor_, v_actor_, total.actor, lr, c1, c2, eps);
+      adam_net(critic_, m_critic_, v_critic_, total.critic, lr, c1, c2, eps);
+      adam(log_std_, m_log_std_, v_log_std_, total.log_std, lr, c1, c2, eps);
+      pl += total.policy_loss;
+      vl += total.value_loss;
+      kl = total.approx_kl * inv_m;  // the last minibatch's, as the baseline's early stop
+      clipped += total.clipped;
+      seen += mb;
+    }
+    stats.epochs = epoch + 1;
+    stats.policy_loss = pl / static_cast<double>(seen);
+    stats.value_loss = vl / static_cast<double>(seen);
+    stats.approx_kl = kl;
+    stats.clip_fraction = static_cast<double>(clipped) / static_cast<double>(seen);
+    if (o_.target_kl > 0 && kl > o_.target_kl) break;
+  }
+  return stats;
+}
+
+MlpWeights PpoLearner::actor_weights(sim::TaskId task, const nlohmann::json& training) const {
+  MlpWeights w;
+  w.task = task;
+  w.history = 0;
+  w.layers = sizes_of(static_cast<int>(actor_.w.front().cols()), o_.hidden, kActionDim);
+  w.input_mean = Eigen::VectorXf::Zero(w.layers.front());
+  w.input_std = Eigen::VectorXf::Ones(w.layers.front());
+  w.w = actor_.w;
+  w.b = actor_.b;
+  w.training = training;
+  return w;
+}
+
+PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
+                    const std::function<void(const PpoIteration&)>& progress,
+                    const std::function<void(const MlpWeights&)>& checkpoint) {
+  if (o.num_envs <= 0 || o.num_steps <= 0 || o.total_steps <= 0 || o.num_minibatches <= 0 || o.update_epochs <= 0 ||
+      o.hidden.empty() || !(o.learning_rate > 0) || o.eval_episodes < 0 || o.eval_every < 0 ||
+      static_cast<std::int64_t>(o.num_envs) * o.num_steps < o.num_minibatches)
+    throw std::invalid_argument("train_ppo: envs, steps, minibatches, epochs, hidden layers and learning rate must be positive");
+  for (int h : o.hidden)
+    if (h <= 0 || h > 4096) throw std::invalid_argument("train_ppo: hidden layer widths must be in [1, 4096]");
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const unsigned threads = resolve_threads(o.threads);
+  auto model = sim::EnvModel::make(o.task, sim::profile_config(o.profile));
+  const int obs_dim = model->layout().size();
+  const int n_env = o.num_envs, T = o.num_steps;
+  const std::int64_t per_iter = static_cast<std::int64_t>(n_env) * T;
+  const int iterations = static_cast<int>(std::max<std::int64_t>(1, o.total_steps / per_iter));
+  PpoLearner learner(o, obs_dim);
+
+  // environments, each with its own noise stream and episode counter
+  std::vector<std::unique_ptr<sim::Env>> envs;
+  std::vector<Rng> noise;
+  std::vector<std::uint64_t> episode_count(static_cast<std::size_t>(n_env), 0);
+  Eigen::MatrixXf cur(obs_dim, n_env);
+  auto episode_seed = [&](int e) {
+    return derive_seed({o.seed, kPpoStream, 2, static_cast<std::uint64_t>(e), episode_count[static_cast<std::size_t>(e)]++});
+  };
+  for (int e = 0; e < n_env; ++e) {
+    envs.push_back(std::make_unique<sim::Env>(model));
+    noise.emplace_back(derive_seed({o.seed, kPpoStream, 1, static_cast<std::uint64_t>(e)}));
+    cur.col(e) = envs.back()->reset(episode_seed(e)).cast<float>();
+  }
+
+  // per-step storage, column (t * n_env + e)
+  PpoBatch batch;
+  batch.obs.resize(obs_dim, per_iter);
+  batch.actions.resize(kActionDim, per_iter);
+  batch.log_probs.resize(per_iter);
+  batch.advantages.resize(per_iter);
+  batch.returns.resize(per_iter);
+  Eigen::VectorXf values(per_iter), rewards(per_iter), final_values = Eigen::VectorXf::Zero(per_iter);
+  std::vector<std::uint8_t> ended(static_cast<std::size_t>(per_iter));
+  // per-env results of one step, written by the workers by env index
+  std::vector<float> step_reward(static_cast<std::size_t>(n_env));
+  std::vector<std::uint8_t> step_end(static_cast<std::size_t>(n_env)), step_trunc(static_cast<std::size_t>(n_env)),
+      step_success(static_cast<std::size_t>(n_env));
+  std::vector<double> step_return(static_cast<std::size_t>(n_env));
+  Eigen::MatrixXf final_obs(obs_dim, n_env);
+
+  PpoResult result;
+  std::int64_t env_steps = 0;
+  for (int it = 0; it < iterations; ++it) {
+    PpoIteration rec;
+    rec.iteration = it;
+    double return_sum = 0.0;
+    for (int t = 0; t < T; ++t) {
+      const Eigen::MatrixXf mean = learner.mean(cur);
+      const Eigen::VectorXf val = learner.value(cur);
+      const Eigen::VectorXf std = learner.log_std().array().exp().matrix();
+      Eigen::MatrixXf act(kActionDim, n_env);
+      for (int e = 0; e < n_env; ++e)
+        for (int j = 0; j < kActionDim; ++j)
+          act(j, e) = mean(j, e) + std(j) * static_cast<float>(noise[static_cast<std::size_t>(e)].normal());
+      const Eigen::VectorXf lp = learner.log_prob(mean, act);
+      const Eigen::Index base = static_cast<Eigen::Index>(t) * n_env;
+      batch.obs.middleCols(base, n_env) = cur;
+      batch.actions.middleCols(base, n_env) = act;
+      batch.log_probs.segment(base, n_env) = lp;
+      values.segment(base, n_env) = val;
+      std::atomic<int> next{0};
+      WorkerPool pool(threads, [&](unsigned) {
+        while (true) {
+          const int e = next.fetch_add(1);
+          if (e >= n_env) break;
+          const auto ue = static_cast<std::size_t>(e);
+          Action a = act.col(e).cast<double>().cwiseMax(-1.0).cwiseMin(1.0);
+          const sim::StepResult& r = envs[ue]->step(a);
+          step_reward[ue] = static_cast<float>(r.reward);
+          const bool success = r.success;
+          const bool over = r.episode_over();
+          step_success[ue] = success ? 1 : 0;
+          step_end[ue] = (success || over) ? 1 : 0;
+          // time limit without success: bootstrap; success or a safety stop: terminal
+          step_trunc[ue] = (!success && r.truncated && r.safety == sim::SafetyFlag::kNone) ? 1 : 0;
+          if (step_end[ue]) {
+            final_obs.col(e) = r.obs.cast<float>();
+            step_return[ue] = envs[ue]->episode().episode_return;
+            cur.col(e) = envs[ue]->reset(episode_seed(e)).cast<float>();
+          } else {
+            cur.col(e) = r.obs.cast<float>();
+          }
+        }
+      });
+      pool.join();
+      bool any_trunc = false;
+      for (int e = 0; e < n_env; ++e) {
+        const auto ue = static_cast<std::size_t>(e);
+        rewards(base + e) = step_reward[ue];
+        ended[static_cast<std::size_t>(base + e)] = step_end[ue];
+        any_trunc = any_trunc || step_trunc[ue];
+        if (step_end[ue]) {
+          ++rec.episodes;
+          rec.successes += step_success[ue];
+          return_sum += step_return[ue];
+        }
+      }
+      if (any_trunc) {
+        const Eigen::VectorXf fv = learner.value(final_obs);
+        for (int e = 0; e < n_env; ++e)
+          final_values(base + e) = step_trunc[static_cast<std::size_t>(e)] ? fv(e) : 0.0f;
+      } else {
+        final_values.segment(base, n_env).setZero();
+      }
+    }
+    env_steps += per_iter;
+    batch.advantages = gae(rewards, values, final_values, ended, learner.value(cur), n_env, o.gamma, o.gae_lambda);
+    batch.returns = batch.advantages + values;
+    const PpoUpdateStats us = learner.update(batch, derive_seed({o.seed, kPpoStream, 4, static_cast<std::uint64_t>(it)}), threads);
+    rec.env_steps = env_steps;
+    rec.mean_return = rec.episodes > 0 ? return_sum / rec.episodes : std::numeric_limits<double>::quiet_NaN();
+    rec.policy_loss = us.policy_loss;
+    rec.value_loss = us.value_loss;
+    rec.approx_kl = us.approx_kl;
+    rec.clip_fraction = us.clip_fraction;
+    rec.epochs = us.epochs;
+    rec.mean_std = learner.log_std().array().exp().mean();
+    const bool last_it = it + 1 == iterations;
+    if (o.eval_episodes > 0 && (last_it || (o.eval_every > 0 && (it + 1) % o.eval_every == 0))) {
+      nlohmann::json tr = provenance;
+      tr["env_steps"] = env_steps;
+      tr["iterations"] = it + 1;
+      MlpWeights w = learner.actor_weights(o.task, tr);
+      auto shared = std::make_shared<const MlpWeights>(w);
+      MlpPolicy pol(shared, sha256_hex(serialize_mlp(w)));
+      RolloutOptions ro;
+      ro.seed = derive_seed({o.seed, kPpoStream, 3});
+      ro.episodes = o.eval_episodes;
+      ro.threads = threads;
+      const auto outcomes = run_episodes(pol, model, ro);
+      int ok = 0;
+      double ret = 0.0;
+      for (const auto& oc : outcomes) {
+        ok += oc.success_once ? 1 : 0;
+        ret += oc.episode_return;
+      }
+      rec.eval_success = static_cast<double>(ok) / static_cast<double>(outcomes.size());
+      rec.eval_return = ret / static_cast<double>(outcomes.size());
+      w.training["eval_success_once"] = rec.eval_success;
+      w.training["eval_episodes"] = o.eval_episodes;
+      if (checkpoint) checkpoint(w);
+    }
+    rec.seconds = elapsed();
+    result.iterations.push_back(rec);
+    if (progress) progress(rec);
+  }
+  nlohmann::json tr = provenance;
+  tr["env_steps"] = env_steps;
+  tr["iterations"] = iterations;
+  result.wall_seconds = elapsed();
+  if (!result.iterations.empty() && result.iterations.back().eval_success >= 0) {
+    tr["eval_success_once"] = result.iterations.back().eval_success;
+    tr["eval_episodes"] = o.eval_episodes;
+  }
+  result.actor = learner.actor_weights(o.task, tr);
+  return result;
+}
+
+}  // namespace actionshift::policy
