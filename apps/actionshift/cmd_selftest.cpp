@@ -9,6 +9,7 @@
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/synthetic_robot.hpp"
+#include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
@@ -242,6 +243,7 @@ int run(const SelftestOptions& o) {
     const auto cal = load_calibration(o);
     so.model = cal.model();
     so.frame_rotation = o.frame_rotation == "identity" ? selftest::FrameRotation::kIdentity : selftest::FrameRotation::kMeasured;
+    so.gripper = selftest::GripperMap{sim::kFingerTargetOffset, sim::kFingerTargetGain};  // probes hold the fingers
     char ratio[96];
     if (so.misspec_ratio_absolute)
       std::snprintf(ratio, sizeof ratio, "%.3g (delta wirings), %.3g (absolute)", so.misspec_ratio, *so.misspec_ratio_absolute);
