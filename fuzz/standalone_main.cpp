@@ -10,8 +10,11 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -22,8 +25,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
 namespace {
 
+// an escaped exception is a finding: the input is saved (like libFuzzer's artifacts) and the
+// process aborts
 void run(const std::string& input) {
-  LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(input.data()), input.size());
+  try {
+    LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(input.data()), input.size());
+  } catch (const std::exception& e) {
+    const std::string file = "replay-finding-" + std::to_string(std::hash<std::string>{}(input));
+    std::ofstream(file, std::ios::binary).write(input.data(), static_cast<std::streamsize>(input.size()));
+    std::fprintf(stderr, "finding: %s (input of %zu bytes saved to %s)\n", e.what(), input.size(), file.c_str());
+    std::abort();
+  }
 }
 
 std::string read(const std::filesystem::path& p) {

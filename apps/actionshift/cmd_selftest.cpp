@@ -9,6 +9,7 @@
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/synthetic_robot.hpp"
+#include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
@@ -64,7 +65,7 @@ adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
   if (auto text = data::builtin_calibration_text(o.task, o.profile))
     return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/" + o.task);
   throw InputError("", "--calibration",
-                   "no built-in response calibration for task '" + o.task + "' in this build: pass --calibration FILE");
+                   "no built-in response calibration for task " + quote_input(o.task) + " in this build: pass --calibration FILE");
 }
 
 selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::ObservationLayout& layout) {
@@ -181,9 +182,9 @@ int run(const SelftestOptions& o) {
     throw InputError("", "--demo", "--demo and --hidden-contract are mutually exclusive");
   if (o.sim && !o.demo.empty()) throw InputError("", "--demo", "--demo is synthetic; use --hidden-contract with --sim");
   if (o.strategy != "fixed" && o.strategy != "entropy")
-    throw InputError("", "--strategy", "must be fixed or entropy (got '" + o.strategy + "')");
+    throw InputError("", "--strategy", "must be fixed or entropy (got " + quote_input(o.strategy) + ")");
   if (o.frame_rotation != "live" && o.frame_rotation != "identity")
-    throw InputError("", "--frame-rotation", "must be live or identity (got '" + o.frame_rotation + "')");
+    throw InputError("", "--frame-rotation", "must be live or identity (got " + quote_input(o.frame_rotation) + ")");
   if (!o.sim && o.frame_rotation != "live") throw InputError("", "--frame-rotation", "only applies with --sim");
   if (!o.sim && !o.calibration.empty()) throw InputError("", "--calibration", "only applies with --sim");
   if (!o.sim && (!o.robot.urdf.empty() || !o.robot.packages.empty()))
@@ -202,8 +203,7 @@ int run(const SelftestOptions& o) {
       }
     if (!found)
       throw InputError("", "--demo",
-                       "unknown demo '" + o.demo +
-                           "' (identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled)");
+                       "unknown demo " + quote_input(o.demo) + " (identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled)");
   } else if (!o.hidden_contract.empty()) {
     hidden = resolve_contract_arg(o.hidden_contract, "--hidden-contract");
   }
@@ -243,6 +243,7 @@ int run(const SelftestOptions& o) {
     const auto cal = load_calibration(o);
     so.model = cal.model();
     so.frame_rotation = o.frame_rotation == "identity" ? selftest::FrameRotation::kIdentity : selftest::FrameRotation::kMeasured;
+    so.gripper = selftest::GripperMap{sim::kFingerTargetOffset, sim::kFingerTargetGain};  // probes hold the fingers
     char ratio[96];
     if (so.misspec_ratio_absolute)
       std::snprintf(ratio, sizeof ratio, "%.3g (delta wirings), %.3g (absolute)", so.misspec_ratio, *so.misspec_ratio_absolute);
@@ -292,7 +293,7 @@ Contract resolve_contract_arg(const std::string& arg, const std::string& option)
     const std::string digits = arg.substr(colon + 1);
     const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), i);
     if (parsed.ec != std::errc() || i >= cs.size())
-      throw InputError("", option, "'" + arg + "': index out of range (the manifest has " + std::to_string(cs.size()) +
+      throw InputError("", option, quote_input(arg) + ": index out of range (the manifest has " + std::to_string(cs.size()) +
                                        " contracts)");
     return cs[i];
   }
@@ -301,7 +302,7 @@ Contract resolve_contract_arg(const std::string& arg, const std::string& option)
   const std::string text = is_file ? read_text(arg) : arg;
   if (!is_file && arg.find('{') == std::string::npos)
     throw InputError("", option,
-                     "'" + arg + "' is not a library name (" + selftest::named_contract_list() +
+                     quote_input(arg) + " is not a library name (" + selftest::named_contract_list() +
                          "), MANIFEST:INDEX, a contract file or contract JSON");
   try {
     return Contract::from_json(text);

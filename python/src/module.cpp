@@ -664,7 +664,7 @@ class PySelfTest {
  public:
   PySelfTest(py::object expected, py::object pool, py::object model, const std::string& strategy, int budget,
              double amplitude, double confidence_floor, double misspec_ratio, const std::string& frame_rotation,
-             const std::string& task)
+             const std::string& task, py::object gripper)
       : task_(task) {
     selftest::Options o;
     if (!expected.is_none()) o.expected = to_contract(expected);
@@ -689,6 +689,10 @@ class PySelfTest {
     if (frame_rotation == "measured") o.frame_rotation = selftest::FrameRotation::kMeasured;
     else if (frame_rotation == "identity") o.frame_rotation = selftest::FrameRotation::kIdentity;
     else throw InputError("selftest options", "frame_rotation", "expected 'measured' or 'identity' (got '" + frame_rotation + "')");
+    if (!gripper.is_none()) {  // (offset, gain): the probes hold the fingers (selftest::Options::gripper)
+      const auto g = to_vec<2>(gripper, "gripper");
+      o.gripper = selftest::GripperMap{g[0], g[1]};
+    }
     std::string err;
     auto st = selftest::SelfTest::create(o, &err);
     if (!st) throw std::invalid_argument(err);
@@ -958,11 +962,11 @@ PYBIND11_MODULE(_native, m) {
   // ---- self-test
   py::class_<PySelfTest>(m, "SelfTest", "Plug-and-verify with the control loop inverted (docs/selftest.md).")
       .def(py::init<py::object, py::object, py::object, const std::string&, int, double, double, double,
-                    const std::string&, const std::string&>(),
+                    const std::string&, const std::string&, py::object>(),
            py::arg("expected") = py::none(), py::arg("pool") = py::none(), py::arg("model") = py::none(),
            py::arg("strategy") = "entropy", py::arg("budget") = 6, py::arg("amplitude") = 0.5,
            py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "measured",
-           py::arg("task") = "custom")
+           py::arg("task") = "custom", py::arg("gripper") = py::none())
       .def("begin", &PySelfTest::begin, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
       .def("next_probe", &PySelfTest::next_probe, "The next raw 7-vector to send, or None once the budget is spent.")
       .def("observe", &PySelfTest::observe, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())

@@ -24,15 +24,15 @@ namespace {
 using nlohmann::json;
 
 void check_hash(const std::string& v, const std::string& src, const std::string& field) {
-  if (!is_sha256_hex(v)) throw InputError(src, field, "expected 64 lowercase hex digits (got \"" + v + "\")");
+  if (!is_sha256_hex(v)) throw InputError(src, field, "expected 64 lowercase hex digits (got " + quote_input(v, '"') + ")");
 }
 
 void check_token(const std::string& v, const std::string& src, const std::string& field) {
-  if (!detail::is_token(v)) throw InputError(src, field, "expected a name of [a-z0-9_.-] (got \"" + v + "\")");
+  if (!detail::is_token(v)) throw InputError(src, field, "expected a name of [a-z0-9_.-] (got " + quote_input(v, '"') + ")");
 }
 
 void check_keys(const json& j, const std::set<std::string>& allowed, const std::string& src, const std::string& prefix) {
-  if (!j.is_object()) throw InputError(src, prefix.empty() ? "" : prefix, "expected an object (got " + j.dump() + ")");
+  if (!j.is_object()) throw InputError(src, prefix.empty() ? "" : prefix, "expected an object (got " + json_for_message(j) + ")");
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!allowed.count(it.key())) throw InputError(src, prefix.empty() ? it.key() : prefix + "." + it.key(), "unknown field");
   for (const auto& k : allowed)
@@ -48,13 +48,13 @@ std::optional<std::uint64_t> nonneg_int(const json& v) {
 
 std::string str_at(const json& j, const char* key, const std::string& src, const std::string& field) {
   const json& v = j.at(key);
-  if (!v.is_string()) throw InputError(src, field, "expected a string (got " + v.dump() + ")");
+  if (!v.is_string()) throw InputError(src, field, "expected a string (got " + json_for_message(v) + ")");
   return v.get<std::string>();
 }
 
 json parse_params(const std::string& text, const std::string& src) {
   const json p = parse_json_input(text, src, "method.params");
-  if (!p.is_object()) throw InputError(src, "method.params", "expected a JSON object (got " + p.dump() + ")");
+  if (!p.is_object()) throw InputError(src, "method.params", "expected a JSON object (got " + json_for_message(p) + ")");
   return p;
 }
 
@@ -81,10 +81,10 @@ void validate_job(const JobSpec& job, const std::string& src) {
   if (job.calibration_sha256) check_hash(*job.calibration_sha256, src, "calibration_sha256");
   bool mode_ok = false;
   for (auto m : kRotationModes) mode_ok = mode_ok || job.rotation_mode == m;
-  if (!mode_ok) throw InputError(src, "rotation_mode", "expected \"live\" or \"identity\" (got \"" + job.rotation_mode + "\")");
+  if (!mode_ok) throw InputError(src, "rotation_mode", "expected \"live\" or \"identity\" (got " + quote_input(job.rotation_mode, '"') + ")");
   bool profile_ok = false;
   for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
-  if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got \"" + job.profile + "\")");
+  if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got " + quote_input(job.profile, '"') + ")");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
   if (!(job.obs_noise >= 0.0 && job.obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
     std::ostringstream got;
@@ -188,7 +188,7 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
                  "seed", "split", "task"},
              src, "");
   if (j.at("schema_version") != std::string(kJobSchemaVersion))
-    throw InputError(src, "schema_version", "unsupported job schema version (got " + j.at("schema_version").dump() + ")");
+    throw InputError(src, "schema_version", "unsupported job schema version (got " + json_for_message(j.at("schema_version")) + ")");
   JobSpec job;
   job.task = str_at(j, "task", src, "task");
   const json& split = j.at("split");

@@ -29,8 +29,11 @@ std::string at_line(const std::string& source, const YAML::Node& n) {
   return m.line >= 0 ? source + ":" + std::to_string(m.line + 1) : source;
 }
 
+// a value from the file, quoted for a one-line message (control characters escaped, long text cut)
+std::string shown(const std::string& s) { return quote_input(s, '"'); }
+
 std::string yaml_text(const YAML::Node& n) {
-  if (n.IsScalar()) return "\"" + n.Scalar() + "\"";
+  if (n.IsScalar()) return shown(n.Scalar());
   if (n.IsSequence()) return "a list";
   if (n.IsMap()) return "a mapping";
   return "null";
@@ -113,6 +116,8 @@ json to_json_value(const YAML::Node& n, const std::string& source, const std::st
     for (const auto& kv : n) {
       if (!kv.first.IsScalar()) throw InputError(at_line(source, kv.first), field, "map keys must be plain names");
       const std::string key = kv.first.Scalar();
+      if (invalid_utf8_offset(key) != std::string::npos)
+        throw InputError(at_line(source, kv.first), field, "map key is not valid UTF-8");
       o[key] = to_json_value(kv.second, source, field + "." + key, depth + 1, budget);
     }
     return o;
@@ -127,6 +132,8 @@ json to_json_value(const YAML::Node& n, const std::string& source, const std::st
     if (s == ".nan" || s == ".inf" || s == "-.inf" || s == ".NaN" || s == ".Inf")
       throw InputError(at_line(source, n), field, "non-finite numbers are not allowed");
   }
+  // a double-quoted scalar can spell a byte sequence that is not UTF-8 ("\ud800"), which JSON cannot hold
+  if (invalid_utf8_offset(s) != std::string::npos) throw InputError(at_line(source, n), field, "string is not valid UTF-8");
   return s;
 }
 
@@ -137,7 +144,7 @@ std::string require_string(const YAML::Node& n, const std::string& source, const
 
 std::string require_token(const YAML::Node& n, const std::string& source, const std::string& field) {
   std::string s = require_string(n, source, field);
-  if (!detail::is_token(s)) throw InputError(at_line(source, n), field, "expected a name of [a-z0-9_.-] (got \"" + s + "\")");
+  if (!detail::is_token(s)) throw InputError(at_line(source, n), field, "expected a name of [a-z0-9_.-] (got " + shown(s) + ")");
   return s;
 }
 
@@ -148,7 +155,7 @@ std::vector<std::string> require_token_list(const YAML::Node& n, const std::stri
   for (std::size_t i = 0; i < n.size(); ++i) {
     const std::string f = field + "[" + std::to_string(i) + "]";
     std::string s = require_token(n[i], source, f);
-    if (!seen.insert(s).second) throw InputError(at_line(source, n[i]), f, "duplicate entry \"" + s + "\"");
+    if (!seen.insert(s).second) throw InputError(at_line(source, n[i]), f, "duplicate entry " + shown(s));
     out.push_back(std::move(s));
   }
   return out;
@@ -170,6 +177,11 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
                                      std::to_string(kMaxExperimentBytes) + ")");
   if (yaml_flow_depth(text) > kMaxJsonDepth)
     throw InputError(source, "", "malformed YAML: [ ] / { } nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+  // YAML text is Unicode; ActionShift reads it as UTF-8 only (its values become JSON, which must be UTF-8)
+  if (const auto bad = invalid_utf8_offset(text); bad != std::string_view::npos) {
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(bad), '\n');
+    throw InputError(source + ":" + std::to_string(line), "", "not valid UTF-8 (byte offset " + std::to_string(bad) + ")");
+  }
   YAML::Node root;
   try {
     root = YAML::Load(std::string(text));
@@ -227,7 +239,7 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     }
     // two entries of one method must differ in parameters, or they are the same jobs
     if (!seen_methods.insert(entry.name + entry.params).second)
-      throw InputError(at_line(source, m), f, "duplicate method \"" + entry.name + "\"");
+      throw InputError(at_line(source, m), f, "duplicate method " + shown(entry.name));
     ex.methods.push_back(std::move(entry));
   }
 
@@ -249,7 +261,8 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   ex.backbone = require_string(root["backbone"], source, "backbone");
   if (root["pool"] && root["pool"].IsMap()) {
     for (const auto& kv : root["pool"]) {
-      const std::string split = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) throw InputError(at_line(source, kv.first), "pool", "keys must be split names");
+      const std::string split = kv.first.Scalar();
       if (std::find(ex.splits.begin(), ex.splits.end(), split) == ex.splits.end())
         throw InputError(at_line(source, kv.first), "pool." + split, "names a split that is not in splits");
       ex.split_pools[split] = kv.second.IsNull() ? std::nullopt
@@ -265,14 +278,14 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     ex.rotation_mode = require_string(root["rotation_mode"], source, "rotation_mode");
     if (ex.rotation_mode != "live" && ex.rotation_mode != "identity")
       throw InputError(at_line(source, root["rotation_mode"]), "rotation_mode",
-                       "expected \"live\" or \"identity\" (got \"" + ex.rotation_mode + "\")");
+                       "expected \"live\" or \"identity\" (got " + shown(ex.rotation_mode) + ")");
   }
   if (root["profile"]) {
     ex.profile = require_string(root["profile"], source, "profile");
     bool ok = false;
     for (auto p : kProfiles) ok = ok || ex.profile == p;
     if (!ok)
-      throw InputError(at_line(source, root["profile"]), "profile", "expected \"maniskill\" or \"ideal\" (got \"" + ex.profile + "\")");
+      throw InputError(at_line(source, root["profile"]), "profile", "expected \"maniskill\" or \"ideal\" (got " + shown(ex.profile) + ")");
   }
   return ex;
 }

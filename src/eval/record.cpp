@@ -26,11 +26,7 @@ const std::set<std::string>& record_keys() {
   return keys;
 }
 
-std::string shown(const json& v) {
-  std::string s = v.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
-  return " (got " + s + ")";
-}
+std::string shown(const json& v) { return " (got " + json_for_message(v, 60) + ")"; }
 
 const json& require(const json& j, const char* key, const std::string& src) {
   const auto it = j.find(key);
@@ -73,15 +69,14 @@ double get_number(const json& j, const char* key, const std::string& src) {
 
 void validate_record(const EpisodeRecord& r, const std::string& src) {
   if (r.schema_version != kRecordSchemaVersion)
-    throw InputError(src, "schema_version", "unsupported schema version (got \"" + r.schema_version +
-                                                "\", expected \"" + std::string(kRecordSchemaVersion) + "\")");
-  if (!is_sha256_hex(r.job_id)) throw InputError(src, "job_id", "expected 64 lowercase hex digits (got \"" + r.job_id + "\")");
-  if (!detail::is_token(r.task)) throw InputError(src, "task", "expected a name of [a-z0-9_.-] (got \"" + r.task + "\")");
-  if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got \"" + r.split + "\")");
-  if (!detail::is_token(r.method)) throw InputError(src, "method", "expected a name of [a-z0-9_.-] (got \"" + r.method + "\")");
+    throw InputError(src, "schema_version", "unsupported schema version (got " + quote_input(r.schema_version, '"') + ", expected \"" + std::string(kRecordSchemaVersion) + "\")");
+  if (!is_sha256_hex(r.job_id)) throw InputError(src, "job_id", "expected 64 lowercase hex digits (got " + quote_input(r.job_id, '"') + ")");
+  if (!detail::is_token(r.task)) throw InputError(src, "task", "expected a name of [a-z0-9_.-] (got " + quote_input(r.task, '"') + ")");
+  if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got " + quote_input(r.split, '"') + ")");
+  if (!detail::is_token(r.method)) throw InputError(src, "method", "expected a name of [a-z0-9_.-] (got " + quote_input(r.method, '"') + ")");
   if (r.contract_index < 0) throw InputError(src, "contract_index", "must be >= 0");
   if (!is_sha256_hex(r.contract_sha256))
-    throw InputError(src, "contract_sha256", "expected 64 lowercase hex digits (got \"" + r.contract_sha256 + "\")");
+    throw InputError(src, "contract_sha256", "expected 64 lowercase hex digits (got " + quote_input(r.contract_sha256, '"') + ")");
   if (r.episode_index < 0) throw InputError(src, "episode_index", "must be >= 0");
   if (!std::isfinite(r.task_return)) throw InputError(src, "return", "must be finite");
   if (r.steps < 0) throw InputError(src, "steps", "must be >= 0");
@@ -94,14 +89,14 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
   if (!std::isfinite(r.obs_noise) || r.obs_noise < 0.0) throw InputError(src, "obs_noise", "must be finite and >= 0");
   std::set<std::string> seen;
   for (const auto& f : r.safety_flags) {
-    if (!detail::is_token(f)) throw InputError(src, "safety_flags", "expected names of [a-z0-9_.-] (got \"" + f + "\")");
-    if (!seen.insert(f).second) throw InputError(src, "safety_flags", "duplicate flag \"" + f + "\"");
+    if (!detail::is_token(f)) throw InputError(src, "safety_flags", "expected names of [a-z0-9_.-] (got " + quote_input(f, '"') + ")");
+    if (!seen.insert(f).second) throw InputError(src, "safety_flags", "duplicate flag " + quote_input(f, '"'));
   }
   if (r.backbone.empty()) throw InputError(src, "backbone", "must not be empty");
   for (char c : r.backbone)
     if (static_cast<unsigned char>(c) < 0x20) throw InputError(src, "backbone", "contains a control character");
   if (!is_sha256_hex(r.backbone_sha256))
-    throw InputError(src, "backbone_sha256", "expected 64 lowercase hex digits (got \"" + r.backbone_sha256 + "\")");
+    throw InputError(src, "backbone_sha256", "expected 64 lowercase hex digits (got " + quote_input(r.backbone_sha256, '"') + ")");
 }
 
 nlohmann::json to_json(const EpisodeRecord& r) {

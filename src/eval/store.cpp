@@ -50,7 +50,7 @@ std::string read_fd(int fd, const std::string& path) {
 void check_record_belongs(const EpisodeRecord& r, const JobSpec& job, const std::string& id,
                           std::int64_t episode_index, const std::string& src) {
   auto differs = [&](const char* field, const std::string& got, const std::string& want) {
-    throw InputError(src, field, "record belongs to another job (got \"" + got + "\", expected \"" + want + "\")");
+    throw InputError(src, field, "record belongs to another job (got " + quote_input(got, '"') + ", expected " + quote_input(want, '"') + ")");
   };
   if (r.job_id != id) differs("job_id", r.job_id, id);
   if (r.episode_index != episode_index)

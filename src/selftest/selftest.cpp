@@ -78,6 +78,9 @@ bool validate(const Options& o, std::string* err) noexcept {
   if (!(o.min_frame_angle >= 0.0) || !std::isfinite(o.min_frame_angle))
     return fail(err, "min_frame_angle must be finite and nonnegative (got " + num(o.min_frame_angle) + ")");
   if (o.strategy != Strategy::kFixed && o.strategy != Strategy::kEntropy) return fail(err, "strategy must be fixed or entropy");
+  if (o.gripper && (!std::isfinite(o.gripper->offset) || !std::isfinite(o.gripper->gain) || o.gripper->gain == 0.0))
+    return fail(err, "gripper.offset must be finite and gripper.gain finite and non-zero (got " + num(o.gripper->offset) +
+                         ", " + num(o.gripper->gain) + ")");
   for (int c = 0; c < kPoseDim; ++c) {
     const auto k = static_cast<std::size_t>(c);
     if (!std::isfinite(o.model.alpha[k]) || o.model.alpha[k] == 0.0)
@@ -149,6 +152,7 @@ struct SelfTest::Impl {
   std::vector<Pose6> responses;   // measured TCP response to each
   double path{0}, excursion{0}, turned{0}, fingers{0};
   bool have_fingers{true};
+  std::optional<double> gripper_hold;  // raw gripper command of every probe (Options::gripper), else 0
   double min_angle{std::numeric_limits<double>::infinity()};
 };
 
@@ -188,6 +192,11 @@ bool SelfTest::try_begin(const TcpPose& p, std::string* err) noexcept {
   s.responses.clear();
   s.path = s.excursion = s.turned = s.fingers = 0;
   s.have_fingers = p.fingers.has_value();
+  s.gripper_hold.reset();
+  if (s.opt.gripper && p.fingers) {  // the command whose finger target is where the fingers are now
+    const double g = std::clamp((p.fingers->mean() - s.opt.gripper->offset) / s.opt.gripper->gain, -1.0, 1.0);
+    s.gripper_hold = s.opt.expected.gripper_inverted() ? -g : g;  // raw, under the expected wiring
+  }
   s.min_angle = std::numeric_limits<double>::infinity();
   return true;
 }
@@ -206,7 +215,7 @@ std::optional<Action> SelfTest::next_probe() {
   Action raw = s.choose(s.pending_R);
   // the probe bound is a promise to the caller's hardware: enforce it, whatever the strategy did
   for (int c = 0; c < kPoseDim; ++c) raw[c] = std::clamp(raw[c], -s.opt.amplitude, s.opt.amplitude);
-  raw[kGripper] = 0.0;
+  raw[kGripper] = s.gripper_hold.value_or(0.0);
   s.pending = raw;
   return raw;
 }
@@ -327,6 +336,7 @@ Verdict SelfTest::verdict() const {
   v.max_excursion = s.excursion;
   v.rotation = s.turned;
   v.finger_travel = s.have_fingers && s.started && s.start.fingers ? s.fingers : -1.0;
+  v.gripper_hold = s.gripper_hold;
   if (s.raws.empty() && v.status != Status::kInconclusive) {  // e.g. a one-member pool: never pass without evidence
     v.status = Status::kInconclusive;
     v.reason = "no probe responses observed. Abstaining.";

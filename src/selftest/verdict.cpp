@@ -151,14 +151,23 @@ std::string diff_sentence(const Contract& e, const Contract& w, Field f) {
 }
 
 std::string Verdict::safety_statement(const std::string& unit) const {
+  const std::string gripper = gripper_hold ? "gripper held at its start position (raw gripper command " +
+                                                 fmt("%+.3f", *gripper_hold) + " under the expected wiring's polarity)"
+                                           : "gripper never actuated";
   std::string s = "Probe safety: bounded raw pulses only, |action| <= " + fmt("%g", amplitude) +
-                  " per pose channel, gripper never actuated. Estimated end-effector displacement during probing: " +
+                  " per pose channel, " + gripper + ". Estimated end-effector displacement during probing: " +
                   fmt("%.4f", displacement) + " " + unit + " path over " + std::to_string(probe_steps) +
                   " probe steps (largest distance from the start " + fmt("%.4f", max_excursion) + " " + unit +
                   ", rotation " + fmt("%.4f", rotation) + " rad).";
-  if (finger_travel >= 0)
+  if (finger_travel >= 0 && gripper_hold)
     s += " Finger travel while probing: " + fmt("%.4f", finger_travel) + " " + unit +
-         " (the gripper channel is held at 0, which a controller may map to a mid finger target).";
+         (finger_travel > kFingerHoldTolerance
+              ? " (the fingers moved: a wiring with another gripper polarity, or the zeros an actuation lag sends "
+                "before the first command arrives, drive them away from the held position)."
+              : " (held).");
+  else if (finger_travel >= 0)
+    s += " Finger travel while probing: " + fmt("%.4f", finger_travel) + " " + unit +
+         " (the gripper channel is 0, which a controller may map to a mid finger target).";
   return s;
 }
 
@@ -168,7 +177,7 @@ Verdict decide_verdict(const Evidence& e, double floor, double ratio) {
   v.confidence_floor = floor;
   v.misspec_ratio = ratio;
   v.unchecked.push_back({"gripper_inverted", "gripper polarity is not checked without a gripper probe (the gripper is "
-                                             "never actuated while probing)"});
+                                             "held or left at 0 while probing, never pulsed)"});
   std::vector<Field> checked;
   for (Field f : all_fields()) {
     const auto k = static_cast<std::size_t>(f);
@@ -287,6 +296,7 @@ std::string to_json(const Verdict& v, const ReportHeader& h) {
   j["probe_rotation_rad"] = v.rotation;
   j["displacement_unit"] = h.unit;
   if (v.finger_travel >= 0) j["finger_travel"] = v.finger_travel;
+  if (v.gripper_hold) j["gripper_hold"] = *v.gripper_hold;
   j["safety_statement"] = v.safety_statement(h.unit);
   return j.dump(2);
 }

@@ -8,7 +8,7 @@ namespace actionshift::sim {
 
 double finger_target(double g) {
   const double c = std::clamp(g, -1.0, 1.0);
-  return 0.015 + 0.025 * c;
+  return kFingerTargetOffset + kFingerTargetGain * c;
 }
 
 PoseCommand interpret_pose_command(const Eigen::Matrix<double, 6, 1>& pose) {

@@ -20,6 +20,44 @@ TEST(Contract, IdentityCanonicalJsonAndHashMatchReference) {
   EXPECT_TRUE(id.composition_signature().empty());
 }
 
+// quoting input into a message (core/error.hpp): one line, valid UTF-8, bounded length
+TEST(InputText, PrintableInputEscapesControlBytesAndInvalidUtf8AndCuts) {
+  EXPECT_EQ(printable_input("plain name"), "plain name");
+  EXPECT_EQ(printable_input("a\nb\tc\rd"), "a\\nb\\tc\\rd");
+  EXPECT_EQ(printable_input(std::string("x\0y\x7f", 4)), "x\\x00y\\x7f");
+  EXPECT_EQ(printable_input("caf\xc3\xa9"), "caf\xc3\xa9") << "well-formed UTF-8 is kept";
+  EXPECT_EQ(printable_input("\xff\xc3"), "\\xff\\xc3") << "a stray byte and a truncated sequence are escaped";
+  EXPECT_EQ(printable_input("\xed\xa0\x80"), "\\xed\\xa0\\x80") << "an encoded surrogate is not UTF-8";
+  EXPECT_EQ(printable_input(std::string(100, 'k'), 10), "kkkkkkkkkk... (90 more bytes)");
+  EXPECT_EQ(quote_input("a\nb"), "'a\\nb'");
+  EXPECT_EQ(quote_input("a", '"'), "\"a\"");
+  EXPECT_EQ(invalid_utf8_offset("ok \xc3\xa9 \xe2\x82"), 6u);
+  EXPECT_EQ(invalid_utf8_offset("ok \xf0\x9f\x98\x80"), std::string_view::npos);
+  // every part of an InputError is made one line, whatever its caller passed
+  const InputError e("a\nfile", "key\r\nx", "reason with\na newline and \xff");
+  EXPECT_STREQ(e.what(), "a\\nfile: key\\r\\nx: reason with\\na newline and \\xff");
+  // a JSON value in a message never throws on a string that is not UTF-8 (nlohmann's type_error 316)
+  EXPECT_EQ(json_for_message(nlohmann::json("a\xff")), "\"a\xef\xbf\xbd\"");
+  EXPECT_EQ(json_for_message(nlohmann::json(std::string(200, 'z')), 12), "\"zzzzzzzzzzz... (190 more bytes)");
+}
+
+TEST(Contract, UnknownKeysAreQuotedOnOneLine) {
+  // a key with an escaped newline decodes to a newline; the message escapes it and cuts long keys
+  const std::string text = R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],)"
+                           R"("scale":[1,1,1,1,1,1],"sign":[1,1,1,1,1,1],"target":"delta","x\ny":1,")" +
+                           std::string(500, 'q') + R"(":2})";
+  try {
+    (void)Contract::from_json(text);
+    FAIL() << "unknown keys accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_THAT(what, HasSubstr("unknown contract fields: "));
+    EXPECT_THAT(what, HasSubstr("x\\ny"));
+    EXPECT_LT(what.size(), 200u) << what;
+  }
+}
+
 TEST(Contract, ReferenceGoldenHashes) {
   // golden hashes: docs/reference.md, Contracts
   const auto seen = reference::representative_contracts("seen");

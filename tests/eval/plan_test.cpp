@@ -87,6 +87,20 @@ TEST(Experiment, ErrorsNameFileAndField) {
   fails("name: [unclosed\n", "malformed YAML");
   fails("- just\n- a list\n", "expected a mapping");
   EXPECT_THAT([] { load_experiment("/nonexistent/e.yaml"); }, ThrowsMessage<InputError>(HasSubstr("/nonexistent/e.yaml: cannot open file")));
+  // found by the fuzz replay: text that is not UTF-8 (its strings become JSON, whose dump threw
+  // nlohmann's type_error 316), a "\ud800" escape (a surrogate), and values echoed with their newlines
+  fails(base + "description: caf\xe9\n", "e.yaml:8: not valid UTF-8 (byte offset");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [{name: oracle, params: {k: \"\\ud800\"}}]\nseeds: [1]\n"
+        "episodes: 4\nbackbone: expert\n",
+        "e.yaml:4: malformed YAML: invalid unicode");  // yaml-cpp refuses the surrogate itself
+  fails("name: \"a\\nb\"\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
+        "name: expected a name of [a-z0-9_.-] (got \"a\\nb\")");
+  fails(base + "profile: \"" + std::string(300, 'p') + "\"\n", "(got \"pppppppppp");
+  try {
+    parse_experiment(base + "profile: \"" + std::string(300, 'p') + "\"\n", "e.yaml");
+  } catch (const InputError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 200u) << "a long echo is cut";
+  }
 }
 
 TEST(Plan, CartesianProductInStableOrder) {

@@ -21,13 +21,14 @@ def run_selftest(hidden_name):
     for c in list(library.values()) + actionshift.load_manifest("reference9").contracts:
         if c not in pool:
             pool.append(c)
-    st = actionshift.SelfTest(pool=pool, model=TASK, task=TASK)
+    # the simulator's gripper (finger target 0.015 + 0.025 g), as `--sim` sets it: the probes hold the fingers
+    st = actionshift.SelfTest(pool=pool, model=TASK, task=TASK, gripper=(0.015, 0.025))
     env = actionshift.make(TASK, contract=library[hidden_name])
     obs, _ = env.reset(seed=20260720)
     st.begin(*pose(env, obs))
     probes = 0
     while (raw := st.next_probe()) is not None:
-        assert raw.shape == (7,) and raw[6] == 0.0 and np.all(np.abs(raw[:6]) <= 0.5)
+        assert raw.shape == (7,) and raw[6] == 1.0 and np.all(np.abs(raw[:6]) <= 0.5)  # open fingers held open
         obs, _, _, _, info = env.step(raw)
         assert info["safety"] == "none"
         st.observe(*pose(env, obs))

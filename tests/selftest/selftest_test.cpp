@@ -184,6 +184,65 @@ TEST(SelfTest, ProbesAreBoundedAndNeverActuateTheGripper) {
   }
 }
 
+// Options::gripper: every probe's gripper channel is the command that holds the fingers where begin()
+// found them, under the expected wiring's polarity; the report says so and shows the travel
+TEST(SelfTest, ProbesHoldTheFingersWhereTheyStarted) {
+  struct Case {
+    Eigen::Vector2d fingers;
+    bool expected_inverted;
+    double hold;
+  };
+  for (const Case& c : {Case{{0.04, 0.04}, false, 1.0}, Case{{0.04, 0.04}, true, -1.0}, Case{{0.015, 0.015}, false, 0.0},
+                        Case{{0.0275, 0.0275}, true, -0.5}, Case{{0.09, 0.08}, false, 1.0}}) {
+    Options o = synthetic_options(Strategy::kEntropy);
+    o.gripper = GripperMap{0.015, 0.025};  // the simulator's controller
+    if (c.expected_inverted) {
+      ContractFields f;
+      f.gripper_inverted = true;
+      o.expected = Contract::make(f);
+    }
+    SelfTest st(o);
+    SyntheticRobot robot(o.expected, o.model, 3);
+    TcpPose start = robot.pose();
+    start.fingers = c.fingers;
+    st.begin(start);
+    int n = 0;
+    while (auto raw = st.next_probe()) {
+      EXPECT_NEAR((*raw)[kGripper], c.hold, 1e-12) << "probe " << n;
+      robot.send(*raw);
+      TcpPose p = robot.pose();
+      p.fingers = c.fingers;  // held: the fingers did not move
+      st.observe(p);
+      ++n;
+    }
+    const Verdict v = st.verdict();
+    ASSERT_TRUE(v.gripper_hold.has_value());
+    EXPECT_NEAR(*v.gripper_hold, c.hold, 1e-12);
+    EXPECT_EQ(v.finger_travel, 0.0);
+    EXPECT_THAT(v.safety_statement("m"), HasSubstr("gripper held at its start position (raw gripper command"));
+    EXPECT_THAT(v.safety_statement("m"), HasSubstr("Finger travel while probing: 0.0000 m (held)."));
+  }
+  // no finger positions at begin(): nothing to hold, the channel is 0 and the report says so
+  Options o = synthetic_options(Strategy::kFixed);
+  o.gripper = GripperMap{0.015, 0.025};
+  SelfTest st(o);
+  SyntheticRobot robot(Contract::identity(), o.model, 3);
+  st.begin(robot.pose());
+  EXPECT_EQ((*st.next_probe())[kGripper], 0.0);
+  EXPECT_FALSE(st.verdict().gripper_hold.has_value());
+  EXPECT_THAT(st.verdict().safety_statement("m"), HasSubstr("gripper never actuated"));
+  // travel while holding is reported as movement, never as "held"
+  Verdict moved = st.verdict();
+  moved.gripper_hold = 1.0;
+  moved.finger_travel = 0.048;
+  EXPECT_THAT(moved.safety_statement("m"), HasSubstr("0.0480 m (the fingers moved"));
+  // a gripper map must be usable
+  std::string err;
+  o.gripper = GripperMap{0.015, 0.0};
+  EXPECT_FALSE(validate(o, &err));
+  EXPECT_THAT(err, HasSubstr("gripper.gain"));
+}
+
 TEST(SelfTest, EntropyProbesReturnTowardsTheStart) {
   // every channel's summed raw command stays within ±amplitude, so a delta-wired TCP cannot drift
   Options o = synthetic_options(Strategy::kEntropy);

@@ -113,9 +113,10 @@ class Contract {
       if (std::find(kKeys.begin(), kKeys.end(), it.key()) == kKeys.end()) unknown.push_back(it.key());
     for (const auto& k : kKeys)
       if (!j.contains(k)) missing.push_back(k);
-    auto join = [](const std::vector<std::string>& v) {
+    auto join = [](const std::vector<std::string>& v) {  // keys come from the input: escaped and cut
       std::string s;
-      for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+      for (std::size_t i = 0; i < v.size() && i < 8; ++i) s += (s.empty() ? "" : ", ") + printable_input(v[i], 40);
+      if (v.size() > 8) s += ", ... (" + std::to_string(v.size() - 8) + " more)";
       return s;
     };
     if (!unknown.empty()) throw std::invalid_argument("unknown contract fields: " + join(unknown));

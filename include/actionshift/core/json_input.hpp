@@ -40,6 +40,13 @@ inline std::string json_reason(const std::string& what) {
 
 }  // namespace detail
 
+/// A JSON value quoted into a one-line error message: compact, cut after `max_bytes`, and never
+/// throwing (a string holding bytes that are not UTF-8, e.g. from YAML or a command line, is dumped
+/// with U+FFFD where plain dump() would throw type_error 316).
+inline std::string json_for_message(const nlohmann::json& v, std::size_t max_bytes = 80) {
+  return printable_input(v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), max_bytes);
+}
+
 /// Parse `text` read from `source`. `field` prefixes the field path in errors (e.g. the name of the
 /// argument or header the text came from). Never recurses on the input's structure.
 /// throws InputError(source, field path, reason) for syntax errors, nesting deeper than

@@ -86,9 +86,9 @@ class Manifest {
       if (!kAllowed.count(it.key())) throw InputError(source, it.key(), "unknown field");
     const std::string schema = str("schema_version");
     if (schema != kManifestSchema)
-      throw InputError(source, "schema_version", "unsupported '" + schema + "' (expected '" + kManifestSchema + "')");
+      throw InputError(source, "schema_version", "unsupported " + quote_input(schema) + " (expected " + quote_input(kManifestSchema) + ")");
     const std::string kind = str("kind");
-    if (kind != "split" && kind != "pool") throw InputError(source, "kind", "must be 'split' or 'pool' (got '" + kind + "')");
+    if (kind != "split" && kind != "pool") throw InputError(source, "kind", "must be 'split' or 'pool' (got " + quote_input(kind) + ")");
     if (!j.contains("seed")) throw InputError(source, "seed", "missing field");
     if (!j["seed"].is_number_unsigned()) throw InputError(source, "seed", "must be a nonnegative integer");
     Manifest m(kind == "split" ? Kind::kSplit : Kind::kPool, str("name"), str("rule"), j["seed"].get<std::uint64_t>(),

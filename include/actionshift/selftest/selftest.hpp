@@ -12,7 +12,7 @@
 ///   if (!st) { log(err); return; }
 ///   st->begin(read_tcp_pose());
 ///   while (auto raw = st->next_probe()) {        // nullopt once the budget is spent
-///     robot.send(*raw);                          // |pose channel| <= amplitude, gripper 0
+///     robot.send(*raw);                          // |pose channel| <= amplitude, gripper held (or 0)
 ///     st->observe(read_tcp_pose());
 ///   }
 ///   auto v = st->verdict();                      // PASS / MISMATCH / INCONCLUSIVE, with reasons
@@ -53,6 +53,14 @@ struct TcpPose {
   std::optional<Eigen::Vector2d> fingers;               ///< optional finger joint positions [m]
 };
 
+/// How the caller's gripper follows the gripper channel: each finger's position target is
+/// `offset + gain·g` for a canonical gripper command g clipped to [−1, 1] (the simulator's controller:
+/// offset 0.015 m, gain 0.025 m, docs/semantics.md §1).
+struct GripperMap {
+  double offset{0.0};  ///< finger target at g = 0 [m]
+  double gain{1.0};    ///< finger target change per unit g [m], non-zero
+};
+
 /// Self-test settings (defaults: docs/reference.md, *Self-test*). Validated by validate(), by create() and by the
 /// throwing constructor through the same checker.
 struct Options {
@@ -76,6 +84,13 @@ struct Options {
   /// greedy choice can pulse the same direction every step and walk the arm to its reach limit, where
   /// the response saturates and mimics a scale change). The fixed pulses are balanced by construction.
   bool return_balanced{true};
+  /// If set, every probe holds the fingers where begin() measured them: its gripper channel is the
+  /// canonical command whose finger target is the measured position (mean of the two fingers, g
+  /// clipped to [−1, 1]), encoded with the expected wiring's gripper polarity. Unset (or no finger
+  /// positions at begin()): the gripper channel is 0, which a controller may map to a mid finger
+  /// target. A wiring with another gripper polarity, or the zeros an actuation lag delivers first,
+  /// still move the fingers; the report's finger travel shows it.
+  std::optional<GripperMap> gripper;
 };
 
 /// Checks `o`; on failure returns false and sets `*err` (if non-null) to one line naming the field,
@@ -99,7 +114,8 @@ class SelfTest {
   /// Non-throwing twin of begin(): false and `*err` set for a bad pose.
   bool try_begin(const TcpPose& start, std::string* err) noexcept;
 
-  /// The next raw 7-vector to send (|pose channel| <= amplitude, gripper exactly 0), or nullopt
+  /// The next raw 7-vector to send (|pose channel| <= amplitude; gripper channel the hold command of
+  /// Options::gripper, exactly 0 without one), or nullopt
   /// once the budget is spent. Calling it again before observe() returns the same probe.
   /// Throws std::logic_error if begin() was not called.
   std::optional<Action> next_probe();

@@ -17,6 +17,7 @@
 #include "actionshift/core/contract.hpp"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,9 @@ struct Unchecked {
   std::string reason;  ///< one sentence
 };
 
+/// Finger travel [units of the caller's positions] up to which held fingers count as not moved.
+inline constexpr double kFingerHoldTolerance = 1e-3;
+
 /// The verdict and everything the report shows.
 struct Verdict {
   Status status{Status::kInconclusive};
@@ -76,11 +80,14 @@ struct Verdict {
 
   // probe accounting and the safety statement
   int probe_steps{0};                ///< probes sent and observed
-  double amplitude{0.5};             ///< |raw| bound on every pose channel; gripper channel 0
+  double amplitude{0.5};             ///< |raw| bound on every pose channel
   double displacement{0.0};          ///< TCP path length over the probe steps (units of the caller's positions)
   double max_excursion{0.0};         ///< largest TCP distance from the start position
   double rotation{0.0};              ///< summed |rotation| over the probe steps [rad]
   double finger_travel{-1.0};        ///< summed |finger motion| if finger positions were given, else −1
+  /// The raw gripper command every probe carried, if the gripper was held (Options::gripper with
+  /// finger positions at begin()); unset: the gripper channel was 0.
+  std::optional<double> gripper_hold;
 
   int exit_code() const { return selftest::exit_code(status); }
   /// "Probe safety: bounded raw pulses only, |action| <= 0.5 per pose channel, gripper never actuated. …"

@@ -15,6 +15,8 @@ inline constexpr double kTranslationPerUnit = 0.1;  ///< [m]
 inline constexpr double kRotationPerUnit = 0.1;     ///< [rad]
 
 /// Finger joint target [m] for a gripper command g (clipped to [-1, 1]): 0.015 + 0.025 g.
+inline constexpr double kFingerTargetOffset = 0.015;  ///< [m] at g = 0
+inline constexpr double kFingerTargetGain = 0.025;    ///< [m] per unit g
 double finger_target(double g);
 
 /// Result of interpreting one canonical pose command (6 numbers).
