@@ -196,7 +196,7 @@ int run_calibrate(const CalibrateOptions& o) {
   double mean_r2 = 0.0;
   for (double r : c.fit.fit_r2) mean_r2 += r / 6.0;
   std::cout << "response calibration: " << c.task << " on profile " << c.profile << " (protocol " << c.protocol << ": "
-            << c.episodes << (c.protocol == "reference_walk" ? " walks" : " episodes") << " x " << c.steps
+            << c.episodes << (c.protocol == "episodes" ? " episodes" : " walks") << " x " << c.steps
             << " steps of uniform random actions, seed " << c.seed << ")\n"
             << "tcp_pose at observation offset " << c.slice.position_start << "\n\n"
             << "channel   alpha [per unit]   sigma      R^2\n";

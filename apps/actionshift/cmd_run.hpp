@@ -41,7 +41,7 @@ std::optional<eval::RobotRef> cli_robot_ref(const RobotOptions& o);
 struct CalibrateOptions {
   std::string task;
   std::string profile{"maniskill"};
-  std::string protocol{"reference_walk"};
+  std::string protocol{"maniskill_walk"};
   int episodes{8};
   int steps{64};
   std::uint64_t seed{20260720};

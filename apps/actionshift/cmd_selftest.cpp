@@ -62,8 +62,8 @@ std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
 
 adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
   if (!o.calibration.empty()) return adapt::ResponseCalibration::load(o.calibration);
-  if (auto text = data::builtin_calibration_text(o.task, o.profile))
-    return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/" + o.task);
+  if (auto text = data::builtin_selftest_calibration_text(o.task, o.profile))
+    return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/selftest/" + o.task);
   throw InputError("", "--calibration",
                    "no built-in response calibration for task " + quote_input(o.task) + " in this build: pass --calibration FILE");
 }

@@ -405,10 +405,12 @@ int main(int argc, char** argv) {
   calibrate->add_option("--task", cal_o.task, "Task")->required();
   calibrate->add_option("--profile", cal_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
   calibrate->add_option("--protocol", cal_o.protocol,
-                        "reference_walk (the reference's: random walks without resets, 63 samples each) or\n"
+                        "maniskill_walk (the public reference implementation's, as it runs in ManiSkill: 8 random\n"
+                        "walks of 64 steps, truncated and reset at the task's 50-step horizon as ManiSkill's vector\n"
+                        "wrapper does, 63 samples each), reference_walk (the same walks without the reset) or\n"
                         "episodes (task episodes with resets, capped at the horizon)")
       ->capture_default_str();
-  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (reference_walk) or episodes")->capture_default_str();
+  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (maniskill_walk, reference_walk) or episodes")->capture_default_str();
   calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode")->capture_default_str();
   calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
   calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");

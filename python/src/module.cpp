@@ -671,7 +671,7 @@ class PySelfTest {
     if (!pool.is_none()) o.pool = to_contracts(pool, "pool");
     if (!model.is_none()) {
       if (py::isinstance<py::str>(model)) {
-        o.model = eval::builtin_calibration(model.cast<std::string>()).model();
+        o.model = eval::builtin_selftest_calibration(model.cast<std::string>()).model();
       } else {
         const auto alpha = to_vec<kPoseDim>(model["alpha"], "model.alpha");
         const auto sigma = to_vec<kPoseDim>(model["sigma"], "model.sigma");

@@ -127,8 +127,8 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   c.rotation_mode = str("rotation_mode");
   c.profile = v1 ? "ideal" : str("profile");
   c.protocol = v1 ? "episodes" : str("protocol");
-  if (c.protocol != "reference_walk" && c.protocol != "episodes")
-    throw InputError(source, "protocol", "must be 'reference_walk' or 'episodes'");
+  if (c.protocol != "maniskill_walk" && c.protocol != "reference_walk" && c.protocol != "episodes")
+    throw InputError(source, "protocol", "must be 'maniskill_walk', 'reference_walk' or 'episodes'");
   c.slice.position_start = static_cast<int>(integer("position_start", 0));
   c.slice.quaternion_start = static_cast<int>(integer("quaternion_start", 0));
   c.episodes = static_cast<int>(integer("episodes", 1));

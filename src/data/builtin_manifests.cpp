@@ -24,6 +24,10 @@ std::optional<std::string_view> builtin_calibration_text(std::string_view task, 
   return std::nullopt;
 }
 
+std::optional<std::string_view> builtin_selftest_calibration_text(std::string_view task, std::string_view profile) {
+  return builtin_calibration_text(std::string("selftest/") + std::string(task), profile);
+}
+
 std::vector<std::string> builtin_calibration_tasks() {
   std::vector<std::string> names;
   for (int i = 0; i < detail::kBuiltinCalibrationCount; ++i) names.emplace_back(detail::kBuiltinCalibrations[i].first);

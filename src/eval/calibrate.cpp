@@ -22,13 +22,19 @@ int finger_start(const sim::ObservationLayout& layout) {
 }
 
 std::string_view protocol_name(CalibrationProtocol p) {
-  return p == CalibrationProtocol::kReferenceWalk ? "reference_walk" : "episodes";
+  switch (p) {
+    case CalibrationProtocol::kManiSkillWalk: return "maniskill_walk";
+    case CalibrationProtocol::kReferenceWalk: return "reference_walk";
+    case CalibrationProtocol::kEpisodes: break;
+  }
+  return "episodes";
 }
 
 CalibrationProtocol parse_protocol(std::string_view name) {
+  if (name == "maniskill_walk") return CalibrationProtocol::kManiSkillWalk;
   if (name == "reference_walk") return CalibrationProtocol::kReferenceWalk;
   if (name == "episodes") return CalibrationProtocol::kEpisodes;
-  throw std::invalid_argument("unknown calibration protocol '" + std::string(name) + "' (known: reference_walk, episodes)");
+  throw std::invalid_argument("unknown calibration protocol '" + std::string(name) + "' (known: maniskill_walk, reference_walk, episodes)");
 }
 
 adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model, const CalibrationOptions& o) {
@@ -36,13 +42,15 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
   if (o.steps < 2) throw std::invalid_argument("calibration needs at least two steps per episode");
   if (o.steps > 100000) throw std::invalid_argument("calibration steps must be at most 100000");
   const adapt::TcpSlice slice = tcp_slice(model->layout());
-  const bool walk = o.protocol == CalibrationProtocol::kReferenceWalk;
+  const bool walk = o.protocol != CalibrationProtocol::kEpisodes;
+  const bool autoreset = o.protocol == CalibrationProtocol::kManiSkillWalk;
   int steps = std::min(o.steps, model->horizon());
   if (walk) {
-    // the reference walks have no horizon and no workspace box: the same robot and profile, with
-    // the episode limit raised to the walk length and the workspace opened to the whole table
+    // the reference's walks have no workspace box (ManiSkill has none): the same robot and profile,
+    // with the workspace opened to the whole table; the open walk also raises the episode limit to
+    // the walk length, the ManiSkill walk keeps the task's horizon and resets there
     sim::EnvConfig cfg = model->config();
-    cfg.horizon = o.steps;
+    if (!autoreset) cfg.horizon = o.steps;
     cfg.workspace.lower = Eigen::Vector3d(-10.0, -10.0, -10.0);
     cfg.workspace.upper = Eigen::Vector3d(10.0, 10.0, 10.0);
     model = sim::EnvModel::make(model->task(), cfg, model->robot_ptr());
@@ -55,21 +63,28 @@ adapt::ResponseCalibration calibrate(std::shared_ptr<const sim::EnvModel> model,
   for (int e = 0; e < o.episodes; ++e) {
     Eigen::VectorXd prev = env.reset(derive_seed({o.seed, static_cast<std::uint64_t>(e)}));
     Rng rng(derive_seed({o.seed, static_cast<std::uint64_t>(e), 1}));
+    std::uint64_t resets = 0;
     for (int t = 0; t < steps; ++t) {
       Action a;
       for (int c = 0; c < kActionDim; ++c) a[c] = rng.uniform(-1.0, 1.0);
       const sim::StepResult& r = env.step(a);
       if (r.safety != sim::SafetyFlag::kNone) break;
+      // ManiSkill's vector wrapper returns the fresh episode's first observation on the step that
+      // ends an episode: the sample of that step is the jump to it
+      const bool reset_here = autoreset && r.truncated && t + 1 < steps;
+      Eigen::VectorXd cur = reset_here
+          ? env.reset(derive_seed({o.seed, static_cast<std::uint64_t>(e), 2, ++resets}))
+          : r.obs;
       if (!walk || t > 0) {  // the reference records states after each step: no sample for step 0
         commanded.push_back(a.head<kPoseDim>());
-        observed.push_back(adapt::tcp_response(prev, r.obs, slice));
+        observed.push_back(adapt::tcp_response(prev, cur, slice));
         if (fs >= 0) {
           grip_cmd.push_back(a[kGripper]);
-          grip_obs.push_back(0.5 * (r.obs[fs] + r.obs[fs + 1]) - 0.5 * (prev[fs] + prev[fs + 1]));
+          grip_obs.push_back(0.5 * (cur[fs] + cur[fs + 1]) - 0.5 * (prev[fs] + prev[fs + 1]));
         }
       }
-      prev = r.obs;
-      if (r.episode_over()) break;
+      prev = std::move(cur);
+      if (!reset_here && r.episode_over()) break;
     }
   }
   adapt::ResponseCalibration c;

@@ -50,6 +50,13 @@ adapt::ResponseCalibration builtin_calibration(const std::string& task, const st
   return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + profile + "/" + task);
 }
 
+adapt::ResponseCalibration builtin_selftest_calibration(const std::string& task, const std::string& profile) {
+  const auto text = data::builtin_selftest_calibration_text(task, profile);
+  if (!text)
+    throw InputError("calibration", task, "no built-in self-test calibration for this task on profile '" + profile + "'");
+  return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + profile + "/selftest/" + task);
+}
+
 std::string resolved_method_params(const std::string& method, const std::string& params_json) {
   return canonical_dump(adapt::resolve_method_params(method, parse_params(params_json, method)));
 }

@@ -50,7 +50,7 @@ struct ResponseCalibration {
   std::uint64_t seed{0};           ///< calibration seed
   std::string rotation_mode{"live"};  ///< how canonical rotation commands were applied (always live: unwrapped env)
   std::string profile{"maniskill"};   ///< simulator fidelity profile it was measured on
-  std::string protocol{"reference_walk"};  ///< "reference_walk" (8 walks x 64 steps) or "episodes"
+  std::string protocol{"maniskill_walk"};  ///< "maniskill_walk", "reference_walk" (8 walks x 64 steps) or "episodes"
   /// The finger channel, when calibrated (`calibrate --gripper-channel`). Optional key "gripper"
   /// of the JSON: a file without it serialises (and hashes) exactly as before.
   std::optional<GripperFit> gripper;

@@ -24,7 +24,10 @@ Manifest resolve_manifest(const std::string& name_or_path);
 /// The exact text of the committed response calibration of a task on a simulator fidelity profile
 /// (configs/calibration/<profile>/<task>.json), or nullopt if this build has none for them.
 std::optional<std::string_view> builtin_calibration_text(std::string_view task, std::string_view profile = "maniskill");
-/// Built-in calibrations as "<profile>/<task>", sorted.
+/// The self-test's committed calibration (configs/calibration/<profile>/selftest/<task>.json: walks
+/// that never cross an episode reset, the noise a probing self-test sees), or nullopt.
+std::optional<std::string_view> builtin_selftest_calibration_text(std::string_view task, std::string_view profile = "maniskill");
+/// Built-in calibrations as "<profile>/<task>" (and "<profile>/selftest/<task>"), sorted.
 std::vector<std::string> builtin_calibration_tasks();
 
 }  // namespace actionshift::data

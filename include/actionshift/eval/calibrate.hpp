@@ -12,23 +12,29 @@ namespace actionshift::eval {
 
 /// How the random actions are laid out.
 enum class CalibrationProtocol {
-  /// The public reference implementation's protocol: `episodes` independent random walks (8) of
-  /// `steps` control steps (64) each, no resets and no horizon or workspace stop inside a walk,
-  /// uniform actions in [-1, 1] on all 7 channels (gripper included); the response of step k-1 -> k
-  /// is paired with action k, so the first step of each walk gives no sample (8 x 63 = 504 samples).
+  /// The public reference implementation's protocol as it runs in ManiSkill: `episodes` random walks
+  /// (8 environments) of `steps` control steps (64), uniform actions in [-1, 1] on all 7 channels
+  /// (gripper included), in the task's own episodes: the walk is truncated at the task's horizon (50
+  /// for the cube tasks) and the environment resets there, as ManiSkill's vector wrapper auto-resets
+  /// (ignore_terminations, every environment ends together), so the response paired with the action
+  /// of the step that crosses the horizon is the jump from the walk's end to the fresh episode's start.
+  /// The response of step k-1 -> k is paired with action k: 8 x 63 = 504 samples. No workspace stop.
+  kManiSkillWalk,
+  /// The same walks read without the time limit: no reset and no horizon inside a walk (what the
+  /// project used before it found the auto-reset; kept for the ablation).
   kReferenceWalk,
   /// The project's earlier protocol: `episodes` task episodes (16) of at most `steps` (50, capped at
   /// the horizon), each reset, ended early by a safety check; every step gives a sample.
   kEpisodes,
 };
 
-/// Name of a protocol as recorded in calibration files: "reference_walk" or "episodes".
+/// Name of a protocol as recorded in calibration files: "maniskill_walk", "reference_walk" or "episodes".
 std::string_view protocol_name(CalibrationProtocol p);
 /// Inverse of protocol_name; throws std::invalid_argument naming the known protocols.
 CalibrationProtocol parse_protocol(std::string_view name);
 
 struct CalibrationOptions {
-  CalibrationProtocol protocol{CalibrationProtocol::kReferenceWalk};
+  CalibrationProtocol protocol{CalibrationProtocol::kManiSkillWalk};
   int episodes{8};                  ///< random walks (reference: 8 environments) or episodes
   int steps{64};                    ///< control steps per walk (reference: 64) or per episode
   std::uint64_t seed{20260720};     ///< the reference's calibration seed

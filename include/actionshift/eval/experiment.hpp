@@ -31,6 +31,10 @@ PlanResolver default_resolver();
 
 /// The task's built-in response calibration on a fidelity profile. Throws InputError if this build has none.
 adapt::ResponseCalibration builtin_calibration(const std::string& task, const std::string& profile = "maniskill");
+/// The self-test's built-in calibration of a task (configs/calibration/<profile>/selftest/<task>.json:
+/// random walks that never cross an episode reset, the response noise a probing self-test sees).
+/// Throws InputError if this build has none.
+adapt::ResponseCalibration builtin_selftest_calibration(const std::string& task, const std::string& profile = "maniskill");
 
 /// Method parameters with defaults filled in (adapt::resolve_method_params) as canonical JSON text:
 /// what enters the job spec, so a changed default changes the job id.
