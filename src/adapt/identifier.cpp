@@ -8,6 +8,7 @@
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/rng.hpp"
 #include "actionshift/core/transforms.hpp"
+#include "actionshift/core/weight_file.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -29,19 +30,12 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'S', 'I', 'D', 'W', '\0', '\0', '\1'};
 constexpr std::uint32_t kFormatVersion = 1;
-constexpr std::uint32_t kMaxHeaderBytes = 1u << 20;
 constexpr int kMaxWidth = 4096;
 constexpr int kMaxWindow = 256;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 28;
 
 static_assert(std::endian::native == std::endian::little, "the .asid reader assumes a little-endian host");
 
-void put_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
-std::uint32_t get_u32(std::string_view s, std::size_t at) {
-  std::uint32_t v;
-  std::memcpy(&v, s.data() + at, 4);
-  return v;
-}
 
 using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -77,18 +71,6 @@ int argmax(const Eigen::Ref<const Eigen::VectorXf>& v, int start, int n) {
   for (int k = 1; k < n; ++k)
     if (v[start + k] > v[start + best]) best = k;
   return best;
-}
-
-std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not an identifier weight file");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > kMaxFileBytes) throw InputError(path, "", "weight file too large (" + std::to_string(size) + " bytes)");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path, "", "cannot open identifier weight file");
-  std::string bytes(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>{});
-  if (f.bad()) throw InputError(path, "", "read error");
-  return bytes;
 }
 
 }  // namespace
@@ -235,26 +217,13 @@ std::string serialize_identifier(const IdentifierWeights& w) {
                       {"payload_floats", payload.size() / 4},
                       {"payload_sha256", sha256_hex(payload)},
                       {"training", w.training}};
-  const std::string header = h.dump();
-  std::string out(kMagic, 8);
-  put_u32(out, kFormatVersion);
-  put_u32(out, static_cast<std::uint32_t>(header.size()));
-  out += header;
-  out += payload;
-  return out;
+  return weight_file::frame(std::string_view(kMagic, 8), kFormatVersion, h, payload);
 }
 
 IdentifierWeights parse_identifier(std::string_view bytes, const std::string& source) {
   auto fail = [&source](const std::string& field, const std::string& reason) { return InputError(source, field, reason); };
-  if (bytes.size() < 16) throw fail("", "not an ActionShift identifier weight file (truncated: " + std::to_string(bytes.size()) + " bytes)");
-  if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("magic", "not an ActionShift identifier weight file (bad magic)");
-  const std::uint32_t version = get_u32(bytes, 8);
-  if (version != kFormatVersion) throw fail("version", "unsupported format version " + std::to_string(version) + " (expected 1)");
-  const std::uint32_t hlen = get_u32(bytes, 12);
-  if (hlen > kMaxHeaderBytes || 16 + static_cast<std::size_t>(hlen) > bytes.size())
-    throw fail("header", "truncated file: header of " + std::to_string(hlen) + " bytes does not fit");
-  const nlohmann::json h = parse_json_input(bytes.substr(16, hlen), source, "header");
-  if (!h.is_object()) throw fail("header", "header is not a JSON object");
+  const weight_file::Unframed u = weight_file::unframe(bytes, std::string_view(kMagic, 8), kFormatVersion, source, "identifier weight file");
+  const nlohmann::json& h = u.header;
   auto need = [&](const char* key) -> const nlohmann::json& {
     if (!h.contains(key)) throw fail(std::string("header.") + key, "missing");
     return h.at(key);
@@ -290,12 +259,8 @@ IdentifierWeights parse_identifier(std::string_view bytes, const std::string& so
     throw fail("header.layers", "output size " + std::to_string(w.layers.back()) + " (expected 100)");
   if (h.contains("training")) w.training = h.at("training");
   const std::int64_t floats = 2 * kStepFeatures + w.parameter_count();
-  const std::string_view payload = bytes.substr(16 + hlen);
-  if (static_cast<std::int64_t>(payload.size()) != floats * 4)
-    throw fail("payload", (static_cast<std::int64_t>(payload.size()) < floats * 4 ? "truncated: " : "trailing bytes: ") +
-                              std::to_string(payload.size()) + " bytes, expected " + std::to_string(floats * 4));
-  if (!need("payload_sha256").is_string() || h.at("payload_sha256") != sha256_hex(payload))
-    throw fail("payload", "checksum mismatch (corrupt file)");
+  weight_file::check_payload(u, floats, source, true);
+  const std::string_view payload = u.payload;
   std::size_t at = 0;
   auto take = [&](float* dst, std::int64_t n) {
     std::memcpy(dst, payload.data() + at, static_cast<std::size_t>(n) * 4);
@@ -329,19 +294,11 @@ IdentifierWeights parse_identifier(std::string_view bytes, const std::string& so
   return w;
 }
 
-void save_identifier(const IdentifierWeights& w, const std::string& path) {
-  const std::string bytes = serialize_identifier(w);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(path + ": cannot write");
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw std::runtime_error(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename temporary file");
-}
+void save_identifier(const IdentifierWeights& w, const std::string& path) { weight_file::write_atomic(path, serialize_identifier(w)); }
 
-IdentifierWeights load_identifier(const std::string& path) { return parse_identifier(read_file(path), path); }
+IdentifierWeights load_identifier(const std::string& path) {
+  return parse_identifier(weight_file::read(path, kMaxFileBytes, "identifier weight file"), path);
+}
 
 std::string default_identifiers_dir() {
   if (const char* env = std::getenv("ACTIONSHIFT_IDENTIFIERS_DIR"); env != nullptr && *env != '\0') return env;
@@ -365,7 +322,7 @@ std::shared_ptr<const IdentifierWeights> load_identifier_cached(const std::strin
     return w;
   };
   if (auto it = cache.find(path); it != cache.end()) return check_kind(it->second);
-  const std::string bytes = read_file(path);
+  const std::string bytes = weight_file::read(path, kMaxFileBytes, "identifier weight file");
   // a committed file is pinned by its directory's SHA256SUMS
   const std::filesystem::path p(path);
   const std::filesystem::path sums = p.parent_path() / "SHA256SUMS";

@@ -5,6 +5,7 @@
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/rng.hpp"
+#include "actionshift/core/weight_file.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -23,18 +24,9 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'S', 'M', 'L', 'P', 'W', '\0', '\1'};
 constexpr std::uint32_t kFormatVersion = 1;
-constexpr std::uint32_t kMaxHeaderBytes = 1u << 20;
 constexpr int kMaxLayerWidth = 4096;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;  // 1 GiB; the shipped networks are < 1 MiB
 
-static_assert(std::endian::native == std::endian::little, "the .asmlp reader assumes a little-endian host");
-
-void put_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
-std::uint32_t get_u32(std::string_view s, std::size_t at) {
-  std::uint32_t v;
-  std::memcpy(&v, s.data() + at, 4);
-  return v;
-}
 
 std::string payload_bytes(const MlpWeights& w) {
   std::string out;
@@ -102,29 +94,15 @@ std::string serialize_mlp(const MlpWeights& w) {
                       {"payload_floats", payload.size() / 4},
                       {"payload_sha256", sha256_hex(payload)},
                       {"training", w.training}};
-  const std::string header = h.dump();
-  std::string out(kMagic, 8);
-  put_u32(out, kFormatVersion);
-  put_u32(out, static_cast<std::uint32_t>(header.size()));
-  out += header;
-  out += payload;
-  return out;
+  return weight_file::frame(std::string_view(kMagic, 8), kFormatVersion, h, payload);
 }
 
 MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   auto fail = [&source](const std::string& field, const std::string& reason) -> InputError {
     return InputError(source, field, reason);
   };
-  if (bytes.size() < 16) throw fail("", "not an ActionShift MLP weight file (truncated: " + std::to_string(bytes.size()) + " bytes)");
-  if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("magic", "not an ActionShift MLP weight file (bad magic)");
-  const std::uint32_t version = get_u32(bytes, 8);
-  if (version != kFormatVersion)
-    throw fail("version", "unsupported format version " + std::to_string(version) + " (expected 1)");
-  const std::uint32_t hlen = get_u32(bytes, 12);
-  if (hlen > kMaxHeaderBytes || 16 + static_cast<std::size_t>(hlen) > bytes.size())
-    throw fail("header", "truncated file: header of " + std::to_string(hlen) + " bytes does not fit");
-  const nlohmann::json h = parse_json_input(bytes.substr(16, hlen), source, "header");
-  if (!h.is_object()) throw fail("header", "header is not a JSON object");
+  const weight_file::Unframed u = weight_file::unframe(bytes, std::string_view(kMagic, 8), kFormatVersion, source, "MLP weight file");
+  const nlohmann::json& h = u.header;
   auto need = [&](const char* key) -> const nlohmann::json& {
     if (!h.contains(key)) throw fail(std::string("header.") + key, "missing");
     return h.at(key);
@@ -167,13 +145,8 @@ MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   if (w.layers.back() != kActionDim)
     throw fail("header.layers", "output size " + std::to_string(w.layers.back()) + " (expected 7)");
   const std::int64_t floats = payload_floats(w.layers);
-  const std::string_view payload = bytes.substr(16 + hlen);
-  if (static_cast<std::int64_t>(payload.size()) != floats * 4)
-    throw fail("payload", (static_cast<std::int64_t>(payload.size()) < floats * 4 ? "truncated: " : "trailing bytes: ") +
-                              std::to_string(payload.size()) + " bytes, expected " + std::to_string(floats * 4) +
-                              " for layers of the header");
-  if (h.contains("payload_sha256") && h.at("payload_sha256") != sha256_hex(payload))
-    throw fail("payload", "checksum mismatch (corrupt file)");
+  weight_file::check_payload(u, floats, source, false, " for layers of the header");
+  const std::string_view payload = u.payload;
   // read the arrays
   std::size_t at = 0;
   auto take = [&](float* dst, std::int64_t n) {
@@ -200,34 +173,9 @@ MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   return w;
 }
 
-void save_mlp(const MlpWeights& w, const std::string& path) {
-  const std::string bytes = serialize_mlp(w);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(path + ": cannot write");
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw std::runtime_error(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename temporary file");
-}
+void save_mlp(const MlpWeights& w, const std::string& path) { weight_file::write_atomic(path, serialize_mlp(w)); }
 
-namespace {
-std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a weight file");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > kMaxFileBytes)
-    throw InputError(path, "", "weight file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(kMaxFileBytes) + ")");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path, "", "cannot open weight file");
-  std::string bytes(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>{});
-  if (f.bad()) throw InputError(path, "", "read error");
-  return bytes;
-}
-}  // namespace
-
-MlpWeights load_mlp(const std::string& path) { return parse_mlp(read_file(path), path); }
+MlpWeights load_mlp(const std::string& path) { return parse_mlp(weight_file::read(path, kMaxFileBytes, "weight file"), path); }
 
 Action mlp_forward(const MlpWeights& w, const Eigen::Ref<const Eigen::VectorXf>& x) {
   Eigen::VectorXf h = (x - w.input_mean).cwiseQuotient(w.input_std);
@@ -244,7 +192,7 @@ MlpPolicy::MlpPolicy(std::shared_ptr<const MlpWeights> weights, std::string sha2
 }
 
 std::unique_ptr<MlpPolicy> MlpPolicy::from_file(const std::string& path, const std::string& name) {
-  const std::string bytes = read_file(path);
+  const std::string bytes = weight_file::read(path, kMaxFileBytes, "weight file");
   auto w = std::make_shared<const MlpWeights>(parse_mlp(bytes, path));
   return std::make_unique<MlpPolicy>(std::move(w), sha256_hex(bytes), name);
 }
