@@ -189,9 +189,8 @@ for text, c, b, task, split, kind in findings:
     if not ok:
         cs, bs = d["candidate_success"], d["baseline_success"]
         if min(cs, bs) >= 0.98:
-            reason = (f"both at the ceiling ({cs:.3f} vs {bs:.3f}): with this simulator's cleaner response (docs/sim.md, per-step"
-                      " alpha/sigma 3-5 against about 1) and the closed-loop expert, every belief method identifies the contract"
-                      " before it costs the episode")
+            reason = (f"both at the ceiling ({cs:.3f} vs {bs:.3f}): with the closed-loop expert as the backbone a few steps"
+                      " on a wrong contract do not cost the episode (see the reading above)")
         elif kind == "tie":
             reason = f"a paired difference of {e['estimate']:+.3f} excludes zero here"
         else:
