@@ -188,7 +188,9 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     err << "train ppo: " << o.task << ", layers " << sim::observation_layout(p.task).size() << "-" << o.hidden << "-7 (actor and critic), "
         << iterations << " iterations x " << o.envs << " envs x " << o.rollout_steps << " steps = " << iterations * per_iter
         << " env steps, seed " << o.seed << ", " << policy::resolve_threads(o.threads) << " threads\n";
-    double last_eval = -1.0, last_eval_return = 0.0;
+    double last_eval = -1.0, last_eval_return = 0.0, best_eval = -1.0;
+    std::int64_t best_steps = 0;
+    const std::string best_path = stem + ".best.asmlp";
     auto result = policy::train_ppo(
         p, provenance,
         [&](const policy::PpoIteration& it) {
@@ -227,10 +229,18 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
           else
             err << "  " << l.str() << "\n";
         },
-        [&path, &command](const policy::MlpWeights& w) {
+        [&](const policy::MlpWeights& w) {
           policy::MlpWeights c = w;
           c.training["command"] = command(w.training.at("env_steps").get<std::int64_t>());
           policy::save_mlp(c, path);
+          // the best evaluation so far is kept beside the latest (training's own evaluation episodes,
+          // never Gate 0's), so a late collapse does not lose the peak
+          const double s = w.training.value("eval_success_once", -1.0);
+          if (s > best_eval) {
+            best_eval = s;
+            best_steps = w.training.at("env_steps").get<std::int64_t>();
+            policy::save_mlp(c, best_path);
+          }
         });
     result.actor.training["command"] = command(result.actor.training.at("env_steps").get<std::int64_t>());
     policy::save_mlp(result.actor, path);
@@ -238,6 +248,8 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.actor.parameter_count() << " parameters, sha256 "
         << sha256_hex(bytes) << ") and " << curve_path << " in " << fmt(result.wall_seconds, 1) << " s; final eval success "
         << (last_eval >= 0 ? fmt(last_eval, 3) : std::string("-")) << "\n";
+    if (best_eval >= 0)
+      out << "best eval success " << fmt(best_eval, 3) << " at " << best_steps << " env steps: " << best_path << "\n";
     return 0;
   } catch (const std::invalid_argument& e) {
     err << "actionshift: error: " << e.what() << "\n";
