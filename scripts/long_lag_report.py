@@ -108,7 +108,7 @@ print("its input, DAgger-trained under a lag drawn from {0, 1, 2, 4}); the paper
 print("PPO (observation + last four canonical actions, the same lag distribution). Their reactive counterparts are")
 print("`expert` and `mlp`. The paper's 'frozen ref' column is its reactive PPO.\n")
 print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} nice -n 10 scripts/long_lag {results}`; {len(specs)} jobs, {total:,} episodes;"
-      f" wall time {int(float(wall))} s on {threads} thread(s) of a shared 2-core machine (load average 12-22){cpu_text(CPU)}.")
+      f" wall time {int(float(wall))} s on {threads} thread(s) of a shared {os.cpu_count()}-core machine (load average {os.getloadavg()[1]:.1f} over the last 5 minutes at the end){cpu_text(CPU)}.")
 print(f"- Simulator profile **{', '.join(profiles)}** (docs/sim.md); seeds {', '.join(map(str, seeds))};"
       f" {', '.join(map(str, eps))} episodes per (task, split, backbone, method, seed), dealt round-robin over the split's contracts.")
 print("- Splits: `reference_long_lag` (the paper's two long-lag contracts, lags 2 and 4; exact belief over the")
