@@ -13,6 +13,7 @@ import glob, json, os, sys
 out, src = sys.argv[1], sys.argv[2]
 fail = []
 names = sorted(os.path.basename(f)[:-5] for f in glob.glob(os.path.join(src, "configs/experiments/ladder/*.yaml")))
+isv2 = lambda n: n.startswith("v2_") or n.startswith("gen_v2_")
 v2 = [n for n in names if n.startswith("v2_")]
 if len(v2) < 5:
     fail.append(f"expected the v2 experiments (passive, fixed, hold, hold + corrector, h2-r2 + corrector), found {v2}")
@@ -27,11 +28,11 @@ for n in names:
         if not s["complete"] or s["episodes_done"] != 2:
             fail.append(f"{n}: job {s['job_id'][:12]} incomplete ({s['episodes_done']} episodes)")
         params = s["job"]["method"].get("params") or {}
-        if n.startswith("v2_") and params.get("gripper_channel") is not True:
+        if isv2(n) and params.get("gripper_channel") is not True:
             fail.append(f"{n}: job {s['job_id'][:12]} runs without the finger channel")
-        if n.startswith("v2_") and not s["job"].get("calibration_sha256"):
+        if isv2(n) and not s["job"].get("calibration_sha256"):
             fail.append(f"{n}: job {s['job_id'][:12]} has no calibration")
-        if not n.startswith("v2_") and params.get("gripper_channel") is True:
+        if not isv2(n) and params.get("gripper_channel") is True:
             fail.append(f"{n}: a v1 experiment runs with the finger channel")
 page = open(os.path.join(out, "ladder.md")).read()
 for key in ("passive_v2", "fixed_v2", "hold_v2", "hold_corr_v2", "hold_r2_corr_v2"):
