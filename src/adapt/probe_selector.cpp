@@ -71,8 +71,9 @@ constexpr double kExpCutoff = -708.0;
 // then e = exp(t − max[h]) in place, sums[h] = Σ_j e and weighted[h] = Σ_j e·(t − max[h]), summed
 // in row order. s and o hold kPoseDim rows of ld lanes.
 ACTIONSHIFT_CLONES
-void posterior_kernel(int n, int ld, const double* s, const double* o, const double* logp, double* buf, double* max,
-                      double* sums, double* weighted) {
+void posterior_kernel(int n, int ld, const double* __restrict s, const double* __restrict o,
+                      const double* __restrict logp, double* __restrict buf, double* __restrict max,
+                      double* __restrict sums, double* __restrict weighted) {
   for (int j = 0; j < n; ++j) {
     const V lp = VSPLAT(logp[j]);
     double* row = buf + static_cast<std::ptrdiff_t>(j) * ld;
@@ -111,29 +112,56 @@ void posterior_kernel(int n, int ld, const double* s, const double* o, const dou
   }
 }
 
-// DualABI: for every lane h of the exponentiated array, the MAP of the posterior q(j) = e(j, h) /
-// sums[h] (the first largest) and regret[h] = Σ_j Et(j, MAP) q(j), with Et column-major (ldE rows)
+// DualABI: for every lane h of the exponentiated array, the posterior q(j) = e(j, h) / sums[h]
+// (written to `q`), its MAP (the first largest) and regret[h] = Σ_j Et(j, MAP) q(j), with Et
+// column-major (ldE rows)
 ACTIONSHIFT_CLONES
-void regret_kernel(int n, int ld, const double* buf, const double* sums, const double* Et, int ldE, double* regret) {
+void regret_kernel(int n, int ld, const double* __restrict buf, const double* __restrict sums, const double* __restrict Et,
+                   int ldE, double* __restrict q, double* __restrict regret) {
   for (int h = 0; h < ld; h += kLanes) {
     const V sum = VLOAD(sums + h);
     V best_q = VLOAD(buf + h) / sum;
+    VSTORE(q + h, best_q);
     V best = VSPLAT(0.0);
     for (int j = 1; j < n; ++j) {
-      const V q = VLOAD(buf + static_cast<std::ptrdiff_t>(j) * ld + h) / sum;
-      const VI better = q > best_q;
-      best_q = better ? q : best_q;
+      const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * ld + h;
+      const V qj = VLOAD(buf + at) / sum;
+      VSTORE(q + at, qj);
+      const VI better = qj > best_q;
+      best_q = better ? qj : best_q;
       best = better ? VSPLAT(static_cast<double>(j)) : best;
     }
     const double* col[kLanes];
     for (int l = 0; l < kLanes; ++l) col[l] = Et + static_cast<std::ptrdiff_t>(best[l]) * ldE;
     V acc = VSPLAT(0.0);
     for (int j = 0; j < n; ++j) {
-      const V q = VLOAD(buf + static_cast<std::ptrdiff_t>(j) * ld + h) / sum;
       const V e = V{col[0][j], col[1][j], col[2][j], col[3][j]};
-      acc = acc + e * q;
+      acc = acc + e * VLOAD(q + static_cast<std::ptrdiff_t>(j) * ld + h);
     }
     VSTORE(regret + h, acc);
+  }
+}
+
+// DualABI: the squared decode error of hypothesis i's encoding of the window under every
+// hypothesis j, sq(j, k) = Σ_ch (g_j,ch · raw(p_j,ch, k) − y_j(ch, k))² (channels summed 0..5), for
+// rows j < n and ldw lanes k; raw holds kPoseDim rows, Y kPoseDim rows per hypothesis, of ldw lanes
+ACTIONSHIFT_CLONES
+void task_error_kernel(int n, int ldw, const double* __restrict raw, const double* __restrict Y,
+                       const double* __restrict gain, const int* __restrict perm, double* __restrict sq) {
+  for (int j = 0; j < n; ++j) {
+    const double* y = Y + static_cast<std::ptrdiff_t>(j) * kPoseDim * ldw;
+    const double* g = gain + kPoseDim * j;
+    const int* p = perm + kPoseDim * j;
+    double* out = sq + static_cast<std::ptrdiff_t>(j) * ldw;
+    for (int k = 0; k < ldw; k += kLanes) {
+      V d = g[0] * VLOAD(raw + p[0] * ldw + k) - VLOAD(y + k);
+      V acc = d * d;
+      for (int ch = 1; ch < kPoseDim; ++ch) {
+        d = g[ch] * VLOAD(raw + p[ch] * ldw + k) - VLOAD(y + ch * ldw + k);
+        acc = acc + d * d;
+      }
+      VSTORE(out + k, acc);
+    }
   }
 }
 
@@ -186,6 +214,7 @@ ProbeSelector::ProbeSelector(int pool_size, int max_active, int window)
   O_.assign(kPoseDim * lanes, 0.0);
   motion_.resize(m);
   buf_.assign(static_cast<std::size_t>(m) * lanes, 0.0);
+  if (window > 0) q_.assign(static_cast<std::size_t>(m) * lanes, 0.0);
   sums_.assign(lanes, 0.0);
   max_.assign(lanes, 0.0);
   weighted_.assign(lanes, 0.0);
@@ -193,9 +222,13 @@ ProbeSelector::ProbeSelector(int pool_size, int max_active, int window)
   post_.resize(m);
   if (window > 0) {
     Et_.resize(m, m);
-    raw_.resize(kPoseDim, window);
-    Y_.resize(kPoseDim * m, window);
-    acc_.resize(window);
+    ldw_ = (window + kLanes - 1) / kLanes * kLanes;
+    const auto lw = static_cast<std::size_t>(ldw_);
+    raw_.assign(kPoseDim * lw, 0.0);
+    Y_.assign(kPoseDim * static_cast<std::size_t>(m) * lw, 0.0);
+    sq_.assign(static_cast<std::size_t>(m) * lw, 0.0);
+    gain_.assign(kPoseDim * static_cast<std::size_t>(m), 0.0);
+    perm_.assign(kPoseDim * static_cast<std::size_t>(m), 0);
   }
 }
 
@@ -297,29 +330,33 @@ void ProbeSelector::compute_task_error(const PoolBelief& b, std::span<const Acti
         v.head<3>() = Rt * v.head<3>().eval();
         v.tail<3>() = Rt * v.tail<3>().eval();
       }
-      for (int ch = 0; ch < kPoseDim; ++ch) Y_(kPoseDim * j + ch, k) = v[ch];
+      for (int ch = 0; ch < kPoseDim; ++ch) Y_[static_cast<std::size_t>((kPoseDim * j + ch) * ldw_ + k)] = v[ch];
+    }
+  }
+  for (int j = 0; j < n_; ++j) {
+    const Contract& cj = b.replica(active_[static_cast<std::size_t>(j)]).contract();
+    for (int ch = 0; ch < kPoseDim; ++ch) {
+      const auto l = static_cast<std::size_t>(kPoseDim * j + ch);
+      gain_[l] = cj.gain()[static_cast<std::size_t>(ch)];
+      perm_[l] = cj.permutation()[static_cast<std::size_t>(ch)];
     }
   }
   const double inv_w = 1.0 / static_cast<double>(w);
+  Eigen::Map<Eigen::ArrayXd> sq(sq_.data(), static_cast<Eigen::Index>(n_) * ldw_);
   for (int i = 0; i < n_; ++i) {
     const Decoder& ri = b.replica(active_[static_cast<std::size_t>(i)]);
     const Pose6 tgt = ri.tracked_target();
-    for (int k = 0; k < w; ++k)
-      raw_.col(k) = actionshift::encode(ri.contract(), recent[static_cast<std::size_t>(k)], R, tgt).head<kPoseDim>();
-    const auto raw = raw_.leftCols(w).array();
+    for (int k = 0; k < w; ++k) {
+      const Action raw = actionshift::encode(ri.contract(), recent[static_cast<std::size_t>(k)], R, tgt);
+      for (int ch = 0; ch < kPoseDim; ++ch) raw_[static_cast<std::size_t>(ch * ldw_ + k)] = raw[ch];
+    }
+    task_error_kernel(n_, ldw_, raw_.data(), Y_.data(), gain_.data(), perm_.data(), sq_.data());
+    sq = sq.sqrt();
     for (int j = 0; j < n_; ++j) {
-      if (j == i) {
-        Et_(j, i) = 0.0;
-        continue;
-      }
-      const Contract& cj = b.replica(active_[static_cast<std::size_t>(j)]).contract();
-      const auto& p = cj.permutation();
-      const auto& g = cj.gain();
-      const auto y = Y_.middleRows(kPoseDim * j, kPoseDim).leftCols(w).array();
-      acc_.head(w) = (g[0] * raw.row(p[0]) - y.row(0)).square() + (g[1] * raw.row(p[1]) - y.row(1)).square() +
-                     (g[2] * raw.row(p[2]) - y.row(2)).square() + (g[3] * raw.row(p[3]) - y.row(3)).square() +
-                     (g[4] * raw.row(p[4]) - y.row(4)).square() + (g[5] * raw.row(p[5]) - y.row(5)).square();
-      Et_(j, i) = acc_.head(w).sqrt().sum() * inv_w;
+      const double* row = sq_.data() + static_cast<std::ptrdiff_t>(j) * ldw_;
+      double sum = 0;
+      for (int k = 0; k < w; ++k) sum += row[k];
+      Et_(j, i) = j == i ? 0.0 : sum * inv_w;
     }
   }
 }
@@ -333,6 +370,7 @@ void ProbeSelector::set_task_error(const Eigen::MatrixXd& E) {
 Eigen::MatrixXd ProbeSelector::task_error() const { return Et_.topLeftCorner(n_, n_).transpose(); }
 
 double ProbeSelector::current_regret() {
+  if (window_ < 1) throw std::logic_error("probe selector: built without a DualABI window");
   const Eigen::Index n = n_;
   post_.head(n) = p_.head(n) / p_.head(n).sum();
   Eigen::Index best = 0;
@@ -343,9 +381,10 @@ double ProbeSelector::current_regret() {
 
 double ProbeSelector::expected_future_regret(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
                                              bool lag_aware) {
+  if (window_ < 1) throw std::logic_error("probe selector: built without a DualABI window");
   predict(b, candidate, R, calibrated, lag_aware, false);
   posteriors(calibrated);
-  regret_kernel(n_, ld_, buf_.data(), sums_.data(), Et_.data(), static_cast<int>(Et_.rows()), regret_.data());
+  regret_kernel(n_, ld_, buf_.data(), sums_.data(), Et_.data(), static_cast<int>(Et_.rows()), q_.data(), regret_.data());
   const double mass = p_.head(n_).sum();
   double ef = 0;
   for (int h = 0; h < n_; ++h) ef += p_[h] / mass * regret_[static_cast<std::size_t>(h)];

@@ -73,7 +73,8 @@ class ProbeSelector {
   Eigen::MatrixXd task_error() const;
   /// Regret of acting on the MAP of the active set's normalised probabilities.
   double current_regret();
-  /// Expected regret after observing the response to `candidate` (weights p_h / Σ p).
+  /// Expected regret after observing the response to `candidate` (weights p_h / Σ p). Both regrets
+  /// need a task error (a selector built with window ≥ 1); otherwise std::logic_error.
   double expected_future_regret(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
                                 bool lag_aware);
 
@@ -101,10 +102,14 @@ class ProbeSelector {
   std::vector<double> max_, sums_, weighted_, regret_;  // ld_ lanes
   Eigen::VectorXd post_;
   // DualABI
+  std::vector<double> q_;  // n × ld_ normalised posteriors (regret columns)
   Eigen::MatrixXd Et_;  // transposed task error: Et_(j, i) = E(i, j), so a row of E is a column
-  Eigen::Matrix<double, kPoseDim, Eigen::Dynamic, Eigen::RowMajor> raw_;  // one hypothesis' encoded window
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Y_;  // 6·n × window targets
-  Eigen::Array<double, 1, Eigen::Dynamic> acc_;  // window
+  int ldw_{0};               // lanes per window row: window rounded up to a multiple of 4
+  std::vector<double> raw_;  // one hypothesis' encoded window, kPoseDim rows × ldw_
+  std::vector<double> Y_;    // each hypothesis' targets for the window, kPoseDim·n rows × ldw_
+  std::vector<double> sq_;   // squared decode errors of one hypothesis' encoding, n rows × ldw_
+  std::vector<double> gain_;  // kPoseDim per active hypothesis
+  std::vector<int> perm_;     // kPoseDim per active hypothesis
 };
 
 }  // namespace actionshift::adapt
