@@ -10,6 +10,168 @@
 
 namespace actionshift::adapt {
 
+namespace {
+
+// The hot loops run on four-lane vectors (GCC/Clang vector extensions) and are compiled twice,
+// for AVX2 and for baseline x86-64, the binary choosing at load time (target_clones). Every lane
+// sees the same IEEE operations in the same order in both versions (no fused multiply-add:
+// AVX2 does not imply FMA and the project compiles in ISO mode, -ffp-contract=off), so both
+// give the same bits, and the results do not depend on the vector width.
+constexpr int kLanes = 4;
+typedef double V __attribute__((vector_size(32)));
+typedef long long VI __attribute__((vector_size(32)));
+typedef double VU __attribute__((vector_size(32), aligned(8), may_alias));  // unaligned access
+
+// (ACTIONSHIFT_NO_TARGET_CLONES builds the baseline version only, to compare the two)
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(ACTIONSHIFT_NO_TARGET_CLONES)
+#define ACTIONSHIFT_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define ACTIONSHIFT_CLONES
+#endif
+
+// (macros rather than functions: a function taking or returning a 32-byte vector has a different
+// ABI in the two versions)
+#define VLOAD(p) (*reinterpret_cast<const VU*>(p))
+#define VSTORE(p, v) (*reinterpret_cast<VU*>(p) = (v))
+#define VSPLAT(x) (V{(x), (x), (x), (x)})
+
+// Below this exponent the kernel's exp is exactly 0: exp(−708) ≈ 3.3e−308 is the smallest value it
+// forms as a normal number, and a posterior numerator below it is < 2⁻¹⁰²¹ of the column's largest
+// (which is 1), far below a sum's rounding.
+constexpr double kExpCutoff = -708.0;
+
+// exp(x) for x ≤ 0 by the Cephes rational approximation exactly as Eigen 3.4's pexp evaluates it
+// without FMA (the same constants and operation order; its 2ⁿ scaling is exact in the normal
+// range, as here), so the two agree bit for bit on [−708, 0]; 0 below −708.
+#define ACTIONSHIFT_EXP_BODY(x, out)                                                              \
+  do {                                                                                            \
+    const V magic = VSPLAT(6755399441055744.0); /* 1.5 · 2^52: adding it rounds to an integer */  \
+    V fx = (x) * VSPLAT(1.4426950408889634073599) + VSPLAT(0.5);                                    \
+    V r = (fx + magic) - magic;                                                                   \
+    r = r - ((r > fx) ? VSPLAT(1.0) : VSPLAT(0.0)); /* floor */                                    \
+    const VI bits = (reinterpret_cast<VI>(r + VSPLAT(6755399441055744.0 + 1023.0)) -               \
+                     reinterpret_cast<VI>(magic)) << 52;                                          \
+    V g = (x) - r * VSPLAT(0.693145751953125);                                                     \
+    g = g - r * VSPLAT(1.42860682030941723212e-6);                                                 \
+    const V g2 = g * g;                                                                           \
+    V px = VSPLAT(1.26177193074810590878e-4) * g2 + VSPLAT(3.02994407707441961300e-2);              \
+    px = px * g2 + VSPLAT(9.99999999999999999910e-1);                                              \
+    px = px * g;                                                                                  \
+    V qx = VSPLAT(3.00198505138664455042e-6) * g2 + VSPLAT(2.52448340349684104192e-3);              \
+    qx = qx * g2 + VSPLAT(2.27265548208155028766e-1);                                              \
+    qx = qx * g2 + VSPLAT(2.00000000000000000009e0);                                               \
+    V y = px / (qx - px);                                                                         \
+    y = VSPLAT(2.0) * y + VSPLAT(1.0);                                                              \
+    (out) = ((x) < VSPLAT(kExpCutoff)) ? VSPLAT(0.0) : y * reinterpret_cast<V>(bits);              \
+  } while (0)
+
+// Row j, lane h of `buf` (ld lanes per row, rows j < n): first the log-numerator
+// t(j, h) = log p_j − ½ Σ_ch (o_ch,h − s_ch,j)² (channels summed 0..5), with max[h] = max_j t(j, h);
+// then e = exp(t − max[h]) in place, sums[h] = Σ_j e and weighted[h] = Σ_j e·(t − max[h]), summed
+// in row order. s and o hold kPoseDim rows of ld lanes.
+ACTIONSHIFT_CLONES
+void posterior_kernel(int n, int ld, const double* __restrict s, const double* __restrict o,
+                      const double* __restrict logp, double* __restrict buf, double* __restrict max,
+                      double* __restrict sums, double* __restrict weighted) {
+  for (int j = 0; j < n; ++j) {
+    const V lp = VSPLAT(logp[j]);
+    double* row = buf + static_cast<std::ptrdiff_t>(j) * ld;
+    for (int h = 0; h < ld; h += kLanes) {
+      V d = VLOAD(o + h) - s[j];
+      V acc = d * d;
+      for (int ch = 1; ch < kPoseDim; ++ch) {
+        d = VLOAD(o + ch * ld + h) - s[ch * ld + j];
+        acc = acc + d * d;
+      }
+      const V t = lp - VSPLAT(0.5) * acc;
+      VSTORE(row + h, t);
+      if (j == 0) {
+        VSTORE(max + h, t);
+      } else {
+        const V m = VLOAD(max + h);
+        VSTORE(max + h, t > m ? t : m);
+      }
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    double* row = buf + static_cast<std::ptrdiff_t>(j) * ld;
+    for (int h = 0; h < ld; h += kLanes) {
+      const V x = VLOAD(row + h) - VLOAD(max + h);
+      V e;
+      ACTIONSHIFT_EXP_BODY(x, e);
+      VSTORE(row + h, e);
+      if (j == 0) {
+        VSTORE(sums + h, e);
+        VSTORE(weighted + h, e * x);
+      } else {
+        VSTORE(sums + h, VLOAD(sums + h) + e);
+        VSTORE(weighted + h, VLOAD(weighted + h) + e * x);
+      }
+    }
+  }
+}
+
+// DualABI: for every lane h of the exponentiated array, the posterior q(j) = e(j, h) / sums[h]
+// (written to `q`), its MAP (the first largest) and regret[h] = Σ_j Et(j, MAP) q(j), with Et
+// column-major (ldE rows)
+ACTIONSHIFT_CLONES
+void regret_kernel(int n, int ld, const double* __restrict buf, const double* __restrict sums, const double* __restrict Et,
+                   int ldE, double* __restrict q, double* __restrict regret) {
+  for (int h = 0; h < ld; h += kLanes) {
+    const V sum = VLOAD(sums + h);
+    V best_q = VLOAD(buf + h) / sum;
+    VSTORE(q + h, best_q);
+    V best = VSPLAT(0.0);
+    for (int j = 1; j < n; ++j) {
+      const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * ld + h;
+      const V qj = VLOAD(buf + at) / sum;
+      VSTORE(q + at, qj);
+      const VI better = qj > best_q;
+      best_q = better ? qj : best_q;
+      best = better ? VSPLAT(static_cast<double>(j)) : best;
+    }
+    const double* col[kLanes];
+    for (int l = 0; l < kLanes; ++l) col[l] = Et + static_cast<std::ptrdiff_t>(best[l]) * ldE;
+    V acc = VSPLAT(0.0);
+    for (int j = 0; j < n; ++j) {
+      const V e = V{col[0][j], col[1][j], col[2][j], col[3][j]};
+      acc = acc + e * VLOAD(q + static_cast<std::ptrdiff_t>(j) * ld + h);
+    }
+    VSTORE(regret + h, acc);
+  }
+}
+
+// DualABI: the squared decode error of hypothesis i's encoding of the window under every
+// hypothesis j, sq(j, k) = Σ_ch (g_j,ch · raw(p_j,ch, k) − y_j(ch, k))² (channels summed 0..5), for
+// rows j < n and ldw lanes k; raw holds kPoseDim rows, Y kPoseDim rows per hypothesis, of ldw lanes
+ACTIONSHIFT_CLONES
+void task_error_kernel(int n, int ldw, const double* __restrict raw, const double* __restrict Y,
+                       const double* __restrict gain, const int* __restrict perm, double* __restrict sq) {
+  for (int j = 0; j < n; ++j) {
+    const double* y = Y + static_cast<std::ptrdiff_t>(j) * kPoseDim * ldw;
+    const double* g = gain + kPoseDim * j;
+    const int* p = perm + kPoseDim * j;
+    double* out = sq + static_cast<std::ptrdiff_t>(j) * ldw;
+    for (int k = 0; k < ldw; k += kLanes) {
+      V d = g[0] * VLOAD(raw + p[0] * ldw + k) - VLOAD(y + k);
+      V acc = d * d;
+      for (int ch = 1; ch < kPoseDim; ++ch) {
+        d = g[ch] * VLOAD(raw + p[ch] * ldw + k) - VLOAD(y + ch * ldw + k);
+        acc = acc + d * d;
+      }
+      VSTORE(out + k, acc);
+    }
+  }
+}
+
+}  // namespace
+#undef VLOAD
+#undef VSTORE
+#undef VSPLAT
+#undef ACTIONSHIFT_EXP_BODY
+#undef ACTIONSHIFT_CLONES
+
 int active_set(const Eigen::Ref<const Eigen::VectorXd>& p, int max_active, double mass, std::span<int> order,
                std::span<int> out) {
   const int k = std::min(std::max(1, max_active), static_cast<int>(p.size()));
@@ -32,30 +194,41 @@ int active_set(const Eigen::Ref<const Eigen::VectorXd>& p, int max_active, doubl
 }
 
 ProbeSelector::ProbeSelector(int pool_size, int max_active, int window)
-    : pool_size_(pool_size), max_active_(std::min(max_active, pool_size)), window_(window) {
+    : pool_size_(pool_size),
+      max_active_(std::min(max_active, pool_size)),
+      window_(window),
+      ld_((std::max(max_active_, 1) + kLanes - 1) / kLanes * kLanes) {
   if (pool_size < 1 || max_active < 1 || window < 0)
     throw std::invalid_argument("probe selector needs a pool, max_active >= 1 and window >= 0 (got " +
                                 std::to_string(pool_size) + ", " + std::to_string(max_active) + ", " +
                                 std::to_string(window) + ")");
   const auto m = static_cast<Eigen::Index>(max_active_);
+  const auto lanes = static_cast<std::size_t>(ld_);
   order_.resize(static_cast<std::size_t>(pool_size));
   active_.resize(static_cast<std::size_t>(max_active_));
   p_all_.resize(pool_size);
   p_.resize(m);
-  logp_.resize(m);
-  S_.resize(m, kPoseDim);
-  O_.resize(m, kPoseDim);
+  logp_.assign(lanes, 0.0);
+  // the lanes past n are computed and ignored; zeros keep them finite
+  S_.assign(kPoseDim * lanes, 0.0);
+  O_.assign(kPoseDim * lanes, 0.0);
   motion_.resize(m);
-  buf_.resize(static_cast<std::size_t>(2 * m * m));
-  sums_.resize(m);
-  max_.resize(m);
-  weighted_.resize(m);
+  buf_.assign(static_cast<std::size_t>(m) * lanes, 0.0);
+  if (window > 0) q_.assign(static_cast<std::size_t>(m) * lanes, 0.0);
+  sums_.assign(lanes, 0.0);
+  max_.assign(lanes, 0.0);
+  weighted_.assign(lanes, 0.0);
+  regret_.assign(lanes, 0.0);
   post_.resize(m);
   if (window > 0) {
     Et_.resize(m, m);
-    raw_.resize(kPoseDim, window);
-    Y_.resize(kPoseDim * m, window);
-    acc_.resize(window);
+    ldw_ = (window + kLanes - 1) / kLanes * kLanes;
+    const auto lw = static_cast<std::size_t>(ldw_);
+    raw_.assign(kPoseDim * lw, 0.0);
+    Y_.assign(kPoseDim * static_cast<std::size_t>(m) * lw, 0.0);
+    sq_.assign(static_cast<std::size_t>(m) * lw, 0.0);
+    gain_.assign(kPoseDim * static_cast<std::size_t>(m), 0.0);
+    perm_.assign(kPoseDim * static_cast<std::size_t>(m), 0);
   }
 }
 
@@ -67,7 +240,7 @@ void ProbeSelector::select_active(const PoolBelief& b, int max_active, double ma
   for (int j = 0; j < n_; ++j) {
     const int h = active_[static_cast<std::size_t>(j)];
     p_[j] = p_all_[h];
-    logp_[j] = b.log_probs()[h];
+    logp_[static_cast<std::size_t>(j)] = b.log_probs()[h];
     mass_ += p_[j];
   }
 }
@@ -84,7 +257,7 @@ void ProbeSelector::set_active(const PoolBelief& b, std::span<const int> active)
     if (h < 0 || h >= pool_size_) throw std::invalid_argument("probe selector: hypothesis index out of range");
     active_[static_cast<std::size_t>(j)] = h;
     p_[j] = p_all_[h];
-    logp_[j] = b.log_probs()[h];
+    logp_[static_cast<std::size_t>(j)] = b.log_probs()[h];
     mass_ += p_[j];
   }
 }
@@ -101,28 +274,24 @@ void ProbeSelector::predict(const PoolBelief& b, const Action& c, const Mat3& R,
   for (int j = 0; j < n_; ++j) {
     const Decoder& rep = b.replica(active_[static_cast<std::size_t>(j)]);
     const Action pred = lag_aware ? rep.preview(c, R) : actionshift::decode(rep.contract(), c, R, rep.tracked_target());
-    for (int ch = 0; ch < kPoseDim; ++ch) S_(j, ch) = w[ch] * pred[ch];
+    for (int ch = 0; ch < kPoseDim; ++ch) S_[static_cast<std::size_t>(ch * ld_ + j)] = w[ch] * pred[ch];
     if (!calibrated)
-      for (int ch = 0; ch < kPoseDim; ++ch) O_(j, ch) = inv_sigma[ch] * pred[ch];
+      for (int ch = 0; ch < kPoseDim; ++ch) O_[static_cast<std::size_t>(ch * ld_ + j)] = inv_sigma[ch] * pred[ch];
     if (motion) motion_[j] = m.expected(pred).norm();
   }
 }
 
 void ProbeSelector::posteriors(bool calibrated) {
-  const Eigen::Index n = n_;
-  Eigen::Map<Eigen::ArrayXXd> T(buf_.data(), n, n), E(buf_.data() + n * n, n, n);
-  const Cols6& O = calibrated ? S_ : O_;
-  const auto s = S_.topRows(n).array();
-  const auto logp = logp_.head(n).array();
-  // column h: h's simulated observation; row j: −½ (squared distance to j's mean) + log p_j
-  for (Eigen::Index h = 0; h < n; ++h)
-    T.col(h) = logp - 0.5 * ((s.col(0) - O(h, 0)).square() + (s.col(1) - O(h, 1)).square() + (s.col(2) - O(h, 2)).square() +
-                             (s.col(3) - O(h, 3)).square() + (s.col(4) - O(h, 4)).square() + (s.col(5) - O(h, 5)).square());
-  max_.head(n) = T.colwise().maxCoeff().transpose();
-  T.rowwise() -= max_.head(n).transpose().array();
-  E = T.exp();
-  sums_.head(n) = E.colwise().sum().transpose();
-  weighted_.head(n) = (E * T).colwise().sum().transpose();
+  posterior_kernel(n_, ld_, S_.data(), calibrated ? S_.data() : O_.data(), logp_.data(), buf_.data(), max_.data(),
+                   sums_.data(), weighted_.data());
+}
+
+Eigen::MatrixXd ProbeSelector::last_posteriors() const {
+  Eigen::MatrixXd q(n_, n_);
+  for (int h = 0; h < n_; ++h)
+    for (int j = 0; j < n_; ++j)
+      q(j, h) = buf_[static_cast<std::size_t>(j * ld_ + h)] / sums_[static_cast<std::size_t>(h)];
+  return q;
 }
 
 double ProbeSelector::expected_entropy(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
@@ -132,7 +301,8 @@ double ProbeSelector::expected_entropy(const PoolBelief& b, const Action& candid
   double eh = 0;
   for (int h = 0; h < n_; ++h) {
     // −Σ q ln q of the posterior q_j = e_j / Σe with ln q_j = t_j − ln Σe
-    const double ent = std::log(sums_[h]) - weighted_[h] / sums_[h];
+    const auto l = static_cast<std::size_t>(h);
+    const double ent = std::log(sums_[l]) - weighted_[l] / sums_[l];
     eh += p_[h] / mass_ * ent;
   }
   if (motion) {
@@ -160,29 +330,33 @@ void ProbeSelector::compute_task_error(const PoolBelief& b, std::span<const Acti
         v.head<3>() = Rt * v.head<3>().eval();
         v.tail<3>() = Rt * v.tail<3>().eval();
       }
-      for (int ch = 0; ch < kPoseDim; ++ch) Y_(kPoseDim * j + ch, k) = v[ch];
+      for (int ch = 0; ch < kPoseDim; ++ch) Y_[static_cast<std::size_t>((kPoseDim * j + ch) * ldw_ + k)] = v[ch];
+    }
+  }
+  for (int j = 0; j < n_; ++j) {
+    const Contract& cj = b.replica(active_[static_cast<std::size_t>(j)]).contract();
+    for (int ch = 0; ch < kPoseDim; ++ch) {
+      const auto l = static_cast<std::size_t>(kPoseDim * j + ch);
+      gain_[l] = cj.gain()[static_cast<std::size_t>(ch)];
+      perm_[l] = cj.permutation()[static_cast<std::size_t>(ch)];
     }
   }
   const double inv_w = 1.0 / static_cast<double>(w);
+  Eigen::Map<Eigen::ArrayXd> sq(sq_.data(), static_cast<Eigen::Index>(n_) * ldw_);
   for (int i = 0; i < n_; ++i) {
     const Decoder& ri = b.replica(active_[static_cast<std::size_t>(i)]);
     const Pose6 tgt = ri.tracked_target();
-    for (int k = 0; k < w; ++k)
-      raw_.col(k) = actionshift::encode(ri.contract(), recent[static_cast<std::size_t>(k)], R, tgt).head<kPoseDim>();
-    const auto raw = raw_.leftCols(w).array();
+    for (int k = 0; k < w; ++k) {
+      const Action raw = actionshift::encode(ri.contract(), recent[static_cast<std::size_t>(k)], R, tgt);
+      for (int ch = 0; ch < kPoseDim; ++ch) raw_[static_cast<std::size_t>(ch * ldw_ + k)] = raw[ch];
+    }
+    task_error_kernel(n_, ldw_, raw_.data(), Y_.data(), gain_.data(), perm_.data(), sq_.data());
+    sq = sq.sqrt();
     for (int j = 0; j < n_; ++j) {
-      if (j == i) {
-        Et_(j, i) = 0.0;
-        continue;
-      }
-      const Contract& cj = b.replica(active_[static_cast<std::size_t>(j)]).contract();
-      const auto& p = cj.permutation();
-      const auto& g = cj.gain();
-      const auto y = Y_.middleRows(kPoseDim * j, kPoseDim).leftCols(w).array();
-      acc_.head(w) = (g[0] * raw.row(p[0]) - y.row(0)).square() + (g[1] * raw.row(p[1]) - y.row(1)).square() +
-                     (g[2] * raw.row(p[2]) - y.row(2)).square() + (g[3] * raw.row(p[3]) - y.row(3)).square() +
-                     (g[4] * raw.row(p[4]) - y.row(4)).square() + (g[5] * raw.row(p[5]) - y.row(5)).square();
-      Et_(j, i) = acc_.head(w).sqrt().sum() * inv_w;
+      const double* row = sq_.data() + static_cast<std::ptrdiff_t>(j) * ldw_;
+      double sum = 0;
+      for (int k = 0; k < w; ++k) sum += row[k];
+      Et_(j, i) = j == i ? 0.0 : sum * inv_w;
     }
   }
 }
@@ -195,17 +369,8 @@ void ProbeSelector::set_task_error(const Eigen::MatrixXd& E) {
 
 Eigen::MatrixXd ProbeSelector::task_error() const { return Et_.topLeftCorner(n_, n_).transpose(); }
 
-double ProbeSelector::regret_of_column(int h) {
-  const Eigen::Index n = n_;
-  const Eigen::Map<const Eigen::ArrayXXd> E(buf_.data() + n * n, n, n);
-  post_.head(n) = E.col(h) / sums_[h];
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 1; i < n; ++i)
-    if (post_[i] > post_[best]) best = i;
-  return Et_.col(best).head(n).dot(post_.head(n));
-}
-
 double ProbeSelector::current_regret() {
+  if (window_ < 1) throw std::logic_error("probe selector: built without a DualABI window");
   const Eigen::Index n = n_;
   post_.head(n) = p_.head(n) / p_.head(n).sum();
   Eigen::Index best = 0;
@@ -216,11 +381,13 @@ double ProbeSelector::current_regret() {
 
 double ProbeSelector::expected_future_regret(const PoolBelief& b, const Action& candidate, const Mat3& R, bool calibrated,
                                              bool lag_aware) {
+  if (window_ < 1) throw std::logic_error("probe selector: built without a DualABI window");
   predict(b, candidate, R, calibrated, lag_aware, false);
   posteriors(calibrated);
+  regret_kernel(n_, ld_, buf_.data(), sums_.data(), Et_.data(), static_cast<int>(Et_.rows()), q_.data(), regret_.data());
   const double mass = p_.head(n_).sum();
   double ef = 0;
-  for (int h = 0; h < n_; ++h) ef += p_[h] / mass * regret_of_column(h);
+  for (int h = 0; h < n_; ++h) ef += p_[h] / mass * regret_[static_cast<std::size_t>(h)];
   return ef;
 }
 

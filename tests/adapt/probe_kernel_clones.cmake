@@ -1,0 +1,20 @@
+# Runs the probe-kernel dump built against the library (AVX2 and baseline clones, the CPU picks)
+# and the one built for baseline x86-64 only, and requires identical output.
+# usage: cmake -DCLONED=exe -DBASELINE=exe -DWORK=dir -P probe_kernel_clones.cmake
+foreach(which CLONED BASELINE)
+  execute_process(COMMAND ${${which}} ${WORK}/probe_kernel_${which}.txt RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${${which}} failed (${rc})")
+  endif()
+endforeach()
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/probe_kernel_CLONED.txt ${WORK}/probe_kernel_BASELINE.txt
+                RESULT_VARIABLE differ)
+if(NOT differ EQUAL 0)
+  message(FATAL_ERROR "the AVX2 and baseline probe kernels give different bits (${WORK}/probe_kernel_*.txt)")
+endif()
+file(STRINGS ${WORK}/probe_kernel_CLONED.txt lines)
+list(LENGTH lines n)
+if(n LESS 1000)
+  message(FATAL_ERROR "the dump has only ${n} lines")
+endif()
+message(STATUS "${n} lines identical")
