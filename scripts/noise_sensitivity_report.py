@@ -155,7 +155,15 @@ for lv in levels:
     ratio = " ".join("%.1f" % (a / s) for a, s in zip(c["alpha"][:3], c["sigma"][:3]))
     note = c["profile"]
     if lv["mm"] == 0:
-        note += " (identical to the built-in)" if c == builtin else " (differs from the built-in!)"
+        # the built-in also carries the finger channel (`calibrate --gripper-channel`), which only
+        # grammar_belief reads; the pool methods on this page see the six pose channels
+        pose = lambda d: {k: v for k, v in d.items() if k != "gripper"}
+        if c == builtin:
+            note += " (identical to the built-in)"
+        elif pose(c) == pose(builtin):
+            note += " (the built-in's pose channels, identical; the built-in adds the finger channel)"
+        else:
+            note += " (differs from the built-in!)"
     print(f"| {mm_s(lv['mm'])} | {mean(c['fit_r2']):.3f} | {' '.join('%.2f' % r for r in c['fit_r2'])} | {ratio} | {note} |")
 print()
 
