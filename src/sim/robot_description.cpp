@@ -191,7 +191,16 @@ urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::str
     while (!why.empty() && why.back() == ' ') why.pop_back();
     fail(origin, "not a valid URDF: " + (why.empty() ? std::string("urdfdom could not parse it") : why));
   }
-  return model;
+  // urdfdom links own their children (shared_ptr) and point to their parent weakly; a joint closing a
+  // kinematic loop makes an ownership cycle that would outlive the model. The returned handle owns the
+  // model and cuts every child list when it is released, so a rejected loop frees everything.
+  return urdf::ModelInterfaceSharedPtr(model.get(), [model](urdf::ModelInterface*) {
+    for (auto& [name, link] : model->links_)
+      if (link) {
+        link->child_links.clear();
+        link->child_joints.clear();
+      }
+  });
 }
 
 bool finite(const Eigen::Isometry3d& t) { return t.matrix().allFinite(); }
