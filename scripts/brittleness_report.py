@@ -5,7 +5,7 @@ three seeds with Wilson 95 % intervals and mean probe steps, beside the paper's 
 Standard library only.
 usage: scripts/brittleness_report.py RESULTS_DIR WALL_SECONDS THREADS [CPU] > docs/results/brittleness.md
 (CPU: the `times` line of the runs, e.g. "2m19.630s 0m10.540s")"""
-import glob, json, math, os, re, subprocess, sys
+import glob, json, math, os, subprocess, sys
 from collections import defaultdict
 
 results, wall, threads = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -17,10 +17,8 @@ METHODS = ["no_adapt", "oracle", "entropy_probes", "dualabi", "grammar_belief"]
 BACKBONES = [("expert", "scripted"), ("mlp", "imitation (DAgger MLP)"), ("ppo", "RL (PPO)")]
 
 
-def cpu_text(times_line):
-    """' , CPU time N s' from a bash `times` line ("2m19.630s 0m10.540s"), or '' when not given."""
-    t = re.findall(r"(\d+)m([\d.]+)s", times_line)
-    return "" if not t else f", CPU time {sum(int(m) * 60 + float(x) for m, x in t):.0f} s (user + system)"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report_util import cpu_text  # noqa: E402
 
 
 def wilson(k, n, z=1.959963984540054):

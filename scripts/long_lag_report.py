@@ -7,7 +7,7 @@ index: the same initial state and contract), and the lag-4 contracts on their ow
 Standard library only.
 usage: scripts/long_lag_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS THREADS [CPU] > docs/results/long_lag.md
 (CPU: the `times` line of the runs, e.g. "2m19.630s 0m10.540s")"""
-import glob, json, math, os, re, random, subprocess, sys
+import glob, json, math, os, random, subprocess, sys
 from collections import defaultdict
 
 results, binary, wall, threads = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
@@ -21,10 +21,8 @@ PAIRS = [("expert", "expert-delay-aware"), ("mlp", "mlp-delay-aware")]
 METHOD_NAME = {"oracle": "oracle-encode", "exact_belief": "exact-belief"}
 
 
-def cpu_text(times_line):
-    """' , CPU time N s' from a bash `times` line ("2m19.630s 0m10.540s"), or '' when not given."""
-    t = re.findall(r"(\d+)m([\d.]+)s", times_line)
-    return "" if not t else f", CPU time {sum(int(m) * 60 + float(x) for m, x in t):.0f} s (user + system)"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report_util import cpu_text  # noqa: E402
 
 
 def wilson(k, n, z=1.959963984540054):
