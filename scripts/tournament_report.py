@@ -78,7 +78,8 @@ print("- DualABI's threshold tau was frozen before this run by the pilot on seed
 print("- Paper columns: the paper's Table 5 (and Table 2 for oracle / no_adapt): frozen PPO on ManiSkill, 600 episodes per cell"
       " (Stack: one seed, 200). The paper's \"seen\", \"unseen comp.\" and \"long lag\" are our `reference_*` splits (the same six"
       " contracts); the generated splits have no paper counterpart.")
-print("- The `ideal` profile's earlier tournament (previous calibration protocol) is kept in docs/results/tournament_ideal.md.\n")
+print("- The `ideal` profile's earlier tournament (previous calibration protocol) is kept in docs/results/tournament_ideal.md.")
+print("- The reference cells with the learned (imitation MLP) backbone beside the expert: docs/results/learned_backbone.md.\n")
 print("Success is success_once with its Wilson 95 % interval over the seeds; probe = mean probe steps per episode;"
       " disp. = mean TCP translation during probes [m].\n")
 
