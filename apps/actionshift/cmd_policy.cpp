@@ -40,6 +40,14 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError(path, "", "cannot rename temporary file");
 }
 
+std::vector<int> parse_hidden(const std::string& text);
+
+std::string hidden_text(const std::vector<int>& widths) {
+  std::string s;
+  for (int w : widths) s += (s.empty() ? "" : "-") + std::to_string(w);
+  return s;
+}
+
 }  // namespace
 
 int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) {
@@ -54,6 +62,7 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     t.episodes_per_iteration = o.episodes;
     t.steps_per_iteration = o.steps;
     t.threads = o.threads;
+    t.hidden = parse_hidden(o.hidden);
     if (o.iterations <= 0 || o.episodes <= 0 || o.steps < 0)
       throw InputError("", "train bc", "--iterations and --episodes must be positive, --steps non-negative");
     const std::string backbone = o.delay_aware ? "mlp-delay-aware" : "mlp";
@@ -61,10 +70,10 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
     std::string command = "actionshift train bc --task " + o.task + (o.delay_aware ? " --delay-aware" : "") +
                           " --seed " + std::to_string(o.seed) + " --iterations " + std::to_string(o.iterations) +
                           " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps) +
-                          " --profile " + o.profile;
+                          (o.hidden == TrainBcOptions{}.hidden ? "" : " --hidden " + o.hidden) + " --profile " + o.profile;
     err << "train bc: " << o.task << " " << backbone << ", layers " << sim::observation_layout(t.task).size() +
                                                                             (o.delay_aware ? 28 : 0)
-        << "-256-256-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
+        << "-" << hidden_text(t.hidden) << "-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
     if (o.progress != "off") (void)parse_progress_mode(o.progress);  // validates the mode
     auto result = policy::train_bc(t, [&err, &o](const policy::TrainIteration& it) {
       if (o.progress == "off") return;
@@ -84,6 +93,7 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
                                {"lags", o.delay_aware ? nlohmann::json({0, 1, 2, 4}) : nlohmann::json({0})},
                                {"final_rollout_success", result.iterations.back().successes},
                                {"final_rollout_episodes", result.iterations.back().episodes}};
+    if (o.hidden != TrainBcOptions{}.hidden) result.weights.training["hidden"] = t.hidden;  // default: as before
     policy::save_mlp(result.weights, path);
     const std::string bytes = policy::serialize_mlp(result.weights);
     out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.weights.parameter_count()

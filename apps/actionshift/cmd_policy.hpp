@@ -23,6 +23,7 @@ struct TrainBcOptions {
   unsigned threads{0};              // --threads for data collection (0: all cores)
   std::string out;                  // --out FILE ("" → configs/backbones/<task>.mlp[-delay-aware].asmlp)
   std::string progress{"auto"};     // --progress auto|bar|lines|off: one line per iteration unless off
+  std::string hidden{"256,256"};    // --hidden: tanh hidden layer widths, comma-separated
 };
 int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

@@ -182,6 +182,7 @@ int main(int argc, char** argv) {
   bc->add_option("--episodes", train_o.episodes, "Episodes per iteration")->capture_default_str();
   bc->add_option("--steps", train_o.steps, "Adam steps per iteration")->capture_default_str();
   bc->add_option("--threads", train_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
+  bc->add_option("--hidden", train_o.hidden, "Hidden layer widths (tanh), comma-separated")->capture_default_str();
   bc->add_option("--out", train_o.out, "Weight file (default: configs/backbones/<task>.<backbone>.asmlp)");
   bc->add_option("--progress", train_o.progress, "auto, bar or lines (one line per iteration) or off, as for run")
       ->capture_default_str();
