@@ -8,6 +8,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
@@ -172,7 +173,52 @@ class CapturingHandler final : public console_bridge::OutputHandler {
   std::string first_, first_error_, last_error_;
 };
 
+// The joint graph, read before urdfdom builds its tree. urdfdom links every joint's child into its
+// parent's child list first and checks the tree afterwards: a file it then rejects (a second root,
+// no root) after a joint has closed a cycle leaves links owning each other that it never frees
+// (found by the urdf fuzz target). Rejecting a second parent or a cycle here means urdfdom never
+// builds one. Read with TinyXML, urdfdom's own parser (xml_depth has bounded its recursion); a file
+// TinyXML cannot read is left to urdfdom, which reports the reason.
+std::string joint_graph_problem(const std::string& xml) {
+  TiXmlDocument doc;
+  doc.Parse(xml.c_str());
+  const TiXmlElement* robot = doc.Error() ? nullptr : doc.FirstChildElement("robot");
+  if (robot == nullptr) return {};
+  std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child link -> (parent link, joint)
+  for (const TiXmlElement* j = robot->FirstChildElement("joint"); j != nullptr; j = j->NextSiblingElement("joint")) {
+    const TiXmlElement* p = j->FirstChildElement("parent");
+    const TiXmlElement* c = j->FirstChildElement("child");
+    const char* parent = p != nullptr ? p->Attribute("link") : nullptr;
+    const char* child = c != nullptr ? c->Attribute("link") : nullptr;
+    const char* name = j->Attribute("name");
+    if (parent == nullptr || child == nullptr) continue;  // urdfdom rejects it and says why
+    const auto [it, fresh] = parent_of.emplace(child, std::make_pair(std::string(parent), std::string(name ? name : "?")));
+    if (!fresh)
+      return "link " + std::string(child) + ": child of two joints (" + it->second.second + " and " + (name ? name : "?") +
+             "), a kinematic loop or a second parent; only kinematic trees are supported";
+  }
+  // one parent per link: a cycle is a chain of parents that comes back to a link of the same walk
+  std::map<std::string, int> state;  // 1 on the current walk, 2 finished
+  for (const auto& start : parent_of) {
+    std::vector<std::string> walk;
+    std::string link = start.first;
+    while (true) {
+      const int s = state[link];
+      if (s == 1) return "joints form a kinematic loop through link " + link + "; only kinematic trees are supported";
+      if (s == 2) break;
+      state[link] = 1;
+      walk.push_back(link);
+      const auto up = parent_of.find(link);
+      if (up == parent_of.end()) break;
+      link = up->second.first;
+    }
+    for (const auto& l : walk) state[l] = 2;
+  }
+  return {};
+}
+
 urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::string_view origin) {
+  if (const std::string why = joint_graph_problem(xml); !why.empty()) fail(origin, why);
   static std::mutex mutex;
   std::lock_guard<std::mutex> lock(mutex);
   CapturingHandler handler;

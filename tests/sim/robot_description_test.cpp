@@ -147,6 +147,20 @@ TEST(HostileUrdf, KinematicLoopIsRejectedNotARecursionOverflow) {
   EXPECT_THAT(rejection(loop), HasSubstr("kinematic loop"));
 }
 
+TEST(HostileUrdf, ASecondParentIsRejectedBeforeUrdfdomBuildsItsTree) {
+  // found by the urdf fuzz target: the last arm joint names panda_link4 as its child, so link 4 has two
+  // parents and panda_link7 becomes a second root; urdfdom rejected that only after linking the cycle,
+  // which it never freed (the sanitizer run of this test reports any leak)
+  const std::string two_parents = panda_with(R"(<parent link="panda_link6"/><child link="panda_link7"/>)",
+                                             R"(<parent link="panda_link6"/><child link="panda_link4"/>)");
+  EXPECT_THAT(rejection(two_parents), HasSubstr("link panda_link4: child of two joints (panda_joint4 and panda_joint7)"));
+  // a cycle in which every link has one parent (and no root at all)
+  EXPECT_THAT(rejection(R"(<robot name="r"><link name="a"/><link name="b"/>
+    <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
+    <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint></robot>)"),
+              HasSubstr("joints form a kinematic loop through link"));
+}
+
 TEST(HostileUrdf, UrdfdomsOwnReasonIsInTheMessage) {
   // a revolute joint without <limit>: urdfdom refuses it and says why
   const std::string no_limit = panda_with(R"(<limit lower="-2.8973" upper="2.8973" velocity="2.1750" effort="87"/><dynamics damping="0.003"/>
