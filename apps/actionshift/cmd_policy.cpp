@@ -157,9 +157,11 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     p.eval_every = o.eval_every;
     p.eval_episodes = o.eval_episodes;
     p.threads = o.threads;
+    p.delay_aware = o.delay_aware;
+    p.anneal_lr = o.anneal_lr;
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
-    const std::string path = o.out.empty() ? policy::mlp_weights_path("ppo", p.task) : o.out;
+    const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
     const std::string stem = path.size() > 6 && path.ends_with(".asmlp") ? path.substr(0, path.size() - 6) : path;
     const std::string curve_path = o.curve.empty() ? stem + ".curve.jsonl" : o.curve;
     std::ofstream curve(curve_path, std::ios::trunc);
@@ -172,9 +174,11 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
           << " --epochs " << o.epochs << " --lr " << o.learning_rate << " --gamma " << o.gamma << " --gae-lambda " << o.gae_lambda
           << " --target-kl " << o.target_kl << " --hidden " << o.hidden << " --eval-every " << o.eval_every
           << " --eval-episodes " << o.eval_episodes;
+      if (o.delay_aware) cmd << " --delay-aware";
+      if (o.anneal_lr) cmd << " --anneal-lr";
       return cmd.str();
     };
-    const nlohmann::json provenance = {
+    nlohmann::json provenance = {
         {"command", command(o.total_steps)},
         {"seed", o.seed},
         {"algorithm", "PPO (clipped objective, GAE, Adam), Gaussian actor, state-independent log std; backbone = actor mean"},
@@ -193,9 +197,12 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
         {"max_grad_norm", p.max_grad_norm},
         {"target_kl", o.target_kl},
         {"init_log_std", p.init_log_std}};
+    if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", {0, 1, 2, 4}}};
+    if (o.anneal_lr) provenance["anneal_lr"] = true;
     const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;
     const std::int64_t iterations = std::max<std::int64_t>(1, o.total_steps / per_iter);
-    err << "train ppo: " << o.task << ", layers " << sim::observation_layout(p.task).size() << "-" << o.hidden << "-7 (actor and critic), "
+    err << "train ppo: " << o.task << (o.delay_aware ? " (delay-aware)" : "") << ", layers "
+        << sim::observation_layout(p.task).size() + (o.delay_aware ? policy::kHistoryLength * kActionDim : 0) << "-" << o.hidden << "-7 (actor and critic), "
         << iterations << " iterations x " << o.envs << " envs x " << o.rollout_steps << " steps = " << iterations * per_iter
         << " env steps, seed " << o.seed << ", " << policy::resolve_threads(o.threads) << " threads\n";
     double last_eval = -1.0, last_eval_return = 0.0, best_eval = -1.0;

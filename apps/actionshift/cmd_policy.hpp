@@ -49,6 +49,8 @@ struct TrainPpoOptions {
   std::string out;                  // --out FILE ("" → configs/backbones/<task>.ppo.asmlp)
   std::string curve;                // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
   std::string progress{"auto"};     // --progress auto|bar|lines|off
+  bool delay_aware{false};          // --delay-aware (observation ++ last 4 actions, lags {0,1,2,4})
+  bool anneal_lr{false};            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
 };
 int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

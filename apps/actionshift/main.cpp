@@ -236,6 +236,10 @@ int main(int argc, char** argv) {
   ppo->add_option("--threads", ppo_o.threads, "Worker threads (0: all cores)")->capture_default_str();
   ppo->add_option("--out", ppo_o.out, "Weight file (default: configs/backbones/<task>.ppo.asmlp)");
   ppo->add_option("--curve", ppo_o.curve, "Training curve, JSON lines (default: the weight file's name with .curve.jsonl)");
+  ppo->add_flag("--delay-aware", ppo_o.delay_aware,
+                "Delay-aware PPO (the long-lag solve): the networks also see the last 4 executed actions and each\n"
+                "training episode runs under a lag drawn from {0, 1, 2, 4}; writes <task>.ppo-delay-aware.asmlp");
+  ppo->add_flag("--anneal-lr", ppo_o.anneal_lr, "Anneal the learning rate linearly to 0 over the run");
   ppo->add_option("--progress", ppo_o.progress, "auto, bar (one updating line), lines (one per iteration) or off")->capture_default_str();
   ppo->callback([&] { action = [&] { return cli::run_train_ppo(ppo_o); }; });
   cli::Gate0Options gate0_o;

@@ -6,6 +6,7 @@
 #include "actionshift/core/workers.hpp"
 #include "actionshift/policy/rollout.hpp"
 #include "actionshift/sim/env.hpp"
+#include "actionshift/sim/hidden_contract_env.hpp"
 
 #include <Eigen/QR>
 
@@ -17,6 +18,7 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 namespace actionshift::policy {
@@ -24,6 +26,7 @@ namespace {
 
 constexpr std::uint64_t kPpoStream = 0x7070'6f00'0000'0000ULL;  // keeps PPO seeds apart from evaluation seeds
 constexpr int kGradChunks = 8;  // a minibatch gradient is the ordered sum of this many chunk gradients
+constexpr int kLags[] = {0, 1, 2, 4};  // training lags of the delay-aware run (reference section 13)
 const float kLogSqrt2Pi = static_cast<float>(0.5 * std::log(2.0 * std::numbers::pi));
 
 using Net = PpoLearner::Net;
@@ -307,7 +310,7 @@ PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_s
 MlpWeights PpoLearner::actor_weights(sim::TaskId task, const nlohmann::json& training) const {
   MlpWeights w;
   w.task = task;
-  w.history = 0;
+  w.history = o_.delay_aware ? kHistoryLength : 0;
   w.layers = sizes_of(static_cast<int>(actor_.w.front().cols()), o_.hidden, kActionDim);
   w.input_mean = Eigen::VectorXf::Zero(w.layers.front());
   w.input_std = Eigen::VectorXf::Ones(w.layers.front());
@@ -330,24 +333,40 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(o.threads);
   auto model = sim::EnvModel::make(o.task, sim::profile_config(o.profile));
-  const int obs_dim = model->layout().size();
+  const int env_obs_dim = model->layout().size();
+  const int hist_dim = o.delay_aware ? kHistoryLength * kActionDim : 0;
+  const int obs_dim = env_obs_dim + hist_dim;  // network input: observation ++ executed-action history
   const int n_env = o.num_envs, T = o.num_steps;
   const std::int64_t per_iter = static_cast<std::int64_t>(n_env) * T;
   const int iterations = static_cast<int>(std::max<std::int64_t>(1, o.total_steps / per_iter));
   PpoLearner learner(o, obs_dim);
 
-  // environments, each with its own noise stream and episode counter
+  // environments, each with its own noise stream and episode counter; a delay-aware run wraps each
+  // episode in the identity contract plus a lag drawn for that episode
   std::vector<std::unique_ptr<sim::Env>> envs;
+  std::vector<std::optional<sim::HiddenContractEnv>> lagged(static_cast<std::size_t>(n_env));
   std::vector<Rng> noise;
   std::vector<std::uint64_t> episode_count(static_cast<std::size_t>(n_env), 0);
-  Eigen::MatrixXf cur(obs_dim, n_env);
-  auto episode_seed = [&](int e) {
-    return derive_seed({o.seed, kPpoStream, 2, static_cast<std::uint64_t>(e), episode_count[static_cast<std::size_t>(e)]++});
+  Eigen::MatrixXf cur = Eigen::MatrixXf::Zero(obs_dim, n_env);
+  // new episode of env e; writes its first network input (zero history) into cur.col(e)
+  auto reset_env = [&](int e) {
+    const auto ue = static_cast<std::size_t>(e);
+    const std::uint64_t k = episode_count[ue]++;
+    const std::uint64_t seed = derive_seed({o.seed, kPpoStream, 2, static_cast<std::uint64_t>(e), k});
+    if (!o.delay_aware) {
+      cur.col(e) = envs[ue]->reset(seed).cast<float>();
+      return;
+    }
+    ContractFields f;
+    f.lag = kLags[derive_seed({o.seed, kPpoStream, 5, static_cast<std::uint64_t>(e), k}) % 4];
+    lagged[ue].emplace(model, Contract::make(f));
+    cur.col(e).head(env_obs_dim) = lagged[ue]->reset(seed).cast<float>();
+    cur.col(e).tail(hist_dim).setZero();
   };
   for (int e = 0; e < n_env; ++e) {
-    envs.push_back(std::make_unique<sim::Env>(model));
+    if (!o.delay_aware) envs.push_back(std::make_unique<sim::Env>(model));
     noise.emplace_back(derive_seed({o.seed, kPpoStream, 1, static_cast<std::uint64_t>(e)}));
-    cur.col(e) = envs.back()->reset(episode_seed(e)).cast<float>();
+    reset_env(e);
   }
 
   // per-step storage, column (t * n_env + e)
@@ -393,7 +412,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
           if (e >= n_env) break;
           const auto ue = static_cast<std::size_t>(e);
           Action a = act.col(e).cast<double>().cwiseMax(-1.0).cwiseMin(1.0);
-          const sim::StepResult& r = envs[ue]->step(a);
+          const sim::StepResult& r = o.delay_aware ? lagged[ue]->step(a) : envs[ue]->step(a);
           step_reward[ue] = static_cast<float>(r.reward);
           const bool success = r.success;
           const bool over = r.episode_over();
@@ -401,12 +420,19 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
           step_end[ue] = (success || over) ? 1 : 0;
           // time limit without success: bootstrap; success or a safety stop: terminal
           step_trunc[ue] = (!success && r.truncated && r.safety == sim::SafetyFlag::kNone) ? 1 : 0;
+          // next network input: the observation, and (delay-aware) the history shifted by the executed action
+          Eigen::VectorXf next(obs_dim);
+          next.head(env_obs_dim) = r.obs.cast<float>();
+          if (hist_dim > 0) {
+            next.segment(env_obs_dim, kActionDim) = a.cast<float>();
+            next.tail(hist_dim - kActionDim) = cur.col(e).segment(env_obs_dim, hist_dim - kActionDim);
+          }
           if (step_end[ue]) {
-            final_obs.col(e) = r.obs.cast<float>();
-            step_return[ue] = envs[ue]->episode().episode_return;
-            cur.col(e) = envs[ue]->reset(episode_seed(e)).cast<float>();
+            final_obs.col(e) = next;
+            step_return[ue] = o.delay_aware ? lagged[ue]->episode().episode_return : envs[ue]->episode().episode_return;
+            reset_env(e);
           } else {
-            cur.col(e) = r.obs.cast<float>();
+            cur.col(e) = next;
           }
         }
       });
@@ -432,6 +458,8 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       }
     }
     env_steps += per_iter;
+    if (o.anneal_lr)  // ManiSkill ppo.py: lr * (1 - iteration / iterations), set before each update
+      learner.set_learning_rate(o.learning_rate * (1.0 - static_cast<double>(it) / static_cast<double>(iterations)));
     batch.advantages = gae(rewards, values, final_values, ended, learner.value(cur), n_env, o.gamma, o.gae_lambda);
     batch.returns = batch.advantages + values;
     const PpoUpdateStats us = learner.update(batch, derive_seed({o.seed, kPpoStream, 4, static_cast<std::uint64_t>(it)}), threads);
@@ -455,7 +483,21 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       ro.seed = derive_seed({o.seed, kPpoStream, 3});
       ro.episodes = o.eval_episodes;
       ro.threads = threads;
-      const auto outcomes = run_episodes(pol, model, ro);
+      std::vector<EpisodeOutcome> outcomes;
+      if (!o.delay_aware) {
+        outcomes = run_episodes(pol, model, ro);
+      } else {  // the episodes split over the training lags (contract index = the lag's slot)
+        for (int li = 0; li < 4; ++li) {
+          ContractFields f;
+          f.lag = kLags[li];
+          ro.contract = Contract::make(f);
+          ro.contract_index = static_cast<std::uint64_t>(li);
+          ro.episodes = o.eval_episodes / 4 + (li < o.eval_episodes % 4 ? 1 : 0);
+          if (ro.episodes == 0) continue;
+          const auto part = run_episodes(pol, model, ro);
+          outcomes.insert(outcomes.end(), part.begin(), part.end());
+        }
+      }
       int ok = 0;
       double ret = 0.0;
       for (const auto& oc : outcomes) {

@@ -24,7 +24,7 @@ std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const 
   return dir + "/" + std::string(sim::task_name(task)) + "." + std::string(backbone) + ".asmlp";
 }
 
-std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo"}; }
+std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo", "ppo-delay-aware"}; }
 
 std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task, const RegistryOptions& options) {
   if (backbone == "expert") return make_expert(task);
@@ -40,12 +40,15 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
       throw InputError(path, "history", "mlp-delay-aware needs a network with an action history");
     return p;
   }
-  if (backbone == "ppo") {  // the PPO-trained actor (train ppo): an MLP weight file named ppo
+  if (backbone == "ppo" || backbone == "ppo-delay-aware") {  // the PPO-trained actor (train ppo [--delay-aware])
     const std::string path = mlp_weights_path(backbone, task, options.backbones_dir);
-    auto p = MlpPolicy::from_file(path, "ppo");
+    auto p = MlpPolicy::from_file(path, std::string(backbone));
     if (p->task() != task)
       throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
                                          std::string(sim::task_name(task)));
+    if ((backbone == "ppo-delay-aware") != (p->weights().history > 0))
+      throw InputError(path, "history", backbone == "ppo-delay-aware" ? "ppo-delay-aware needs a network with an action history"
+                                                                      : "ppo needs a network without an action history");
     return p;
   }
   if (backbone.starts_with("external:")) {
@@ -55,7 +58,7 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
   }
   throw InputError("", "backbone",
                    "unknown backbone '" + std::string(backbone) +
-                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, mlp:<path>, external:<command>)");
+                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<path>, external:<command>)");
 }
 
 }  // namespace actionshift::policy

@@ -108,6 +108,40 @@ TEST(PpoTrain, DeterministicWhateverTheThreadsAndLoadsAsABackbone) {
   EXPECT_EQ(pol.clone()->name(), "ppo");
 }
 
+TEST(PpoTrain, DelayAwareSeesTheExecutedActionHistoryAndIsDeterministic) {
+  auto o = tiny(1);
+  o.delay_aware = true;
+  std::vector<policy::MlpWeights> ck;
+  const auto a = policy::train_ppo(o, {}, {}, [&ck](const policy::MlpWeights& w) { ck.push_back(w); });
+  o.threads = 2;
+  EXPECT_EQ(policy::serialize_mlp(policy::train_ppo(o, {}).actor), policy::serialize_mlp(a.actor));
+  EXPECT_EQ(a.actor.history, policy::kHistoryLength);
+  EXPECT_EQ(a.actor.layers, (std::vector<int>{35 + 7 * policy::kHistoryLength, 16, 16, 7}));
+  // the history columns of the first layer are trained (a zero input would leave them untouched:
+  // Adam moves nothing without a gradient), and so are the observation columns
+  ASSERT_EQ(ck.size(), 2u);
+  const auto& w0 = ck[0].w.front();
+  const auto& w1 = ck[1].w.front();
+  EXPECT_GT((w1.rightCols(7 * policy::kHistoryLength) - w0.rightCols(7 * policy::kHistoryLength)).norm(), 0.0f);
+  EXPECT_GT((w1.leftCols(35) - w0.leftCols(35)).norm(), 0.0f);
+  // loads as the delay-aware backbone; the plain `ppo` name is refused for a history network
+  const auto w = policy::parse_mlp(policy::serialize_mlp(a.actor), "ppo-delay-aware.asmlp");
+  EXPECT_EQ(w.history, policy::kHistoryLength);
+}
+
+TEST(PpoTrain, AnnealedLearningRateStartsAtTheSetRateAndThenDeparts) {
+  auto o = tiny(1);
+  std::vector<policy::MlpWeights> plain, annealed;
+  policy::train_ppo(o, {}, {}, [&plain](const policy::MlpWeights& w) { plain.push_back(w); });
+  o.anneal_lr = true;
+  policy::train_ppo(o, {}, {}, [&annealed](const policy::MlpWeights& w) { annealed.push_back(w); });
+  ASSERT_EQ(plain.size(), 2u);
+  ASSERT_EQ(annealed.size(), 2u);
+  // iteration 1 updates at lr * (1 - 0/2) = lr: the same weights; iteration 2 at lr / 2: different
+  EXPECT_EQ(plain[0].w.front(), annealed[0].w.front());
+  EXPECT_NE(plain[1].w.front(), annealed[1].w.front());
+}
+
 TEST(PpoTrain, RejectsNonPositiveSizes) {
   auto o = tiny(1);
   o.num_envs = 0;

@@ -57,6 +57,14 @@ struct PpoOptions {
   int eval_every{10};                     ///< iterations between deterministic evaluations (0: only at the end)
   int eval_episodes{32};                  ///< episodes per evaluation (training seed stream, not Gate 0's)
   unsigned threads{0};                    ///< worker threads (0: all cores)
+  /// Delay-aware (augmented-state) PPO, the reference's long-lag solve: the actor and critic see the
+  /// observation plus the last kHistoryLength executed canonical actions (most recent first), and
+  /// every training episode runs under a lag drawn from {0, 1, 2, 4} (the identity contract plus
+  /// that lag). The frozen backbone carries history = kHistoryLength (backbone `ppo-delay-aware`);
+  /// evaluations split their episodes over the four lags.
+  bool delay_aware{false};
+  /// Anneal the learning rate linearly to 0 over the run (ManiSkill ppo.py's `anneal_lr`).
+  bool anneal_lr{false};
 };
 
 /// One training iteration (rollout + update).
@@ -118,6 +126,8 @@ class PpoLearner {
   /// The clipped-objective update on a batch: update_epochs epochs of shuffled minibatches (shuffle
   /// from `shuffle_seed`), gradient computed by `threads` workers over a fixed chunking.
   PpoUpdateStats update(const PpoBatch& batch, std::uint64_t shuffle_seed, unsigned threads);
+  /// Set the Adam learning rate of the following updates (learning-rate annealing).
+  void set_learning_rate(double lr) { o_.learning_rate = lr; }
 
   /// The actor mean network as a backbone (identity normalisation; `training` = provenance).
   MlpWeights actor_weights(sim::TaskId task, const nlohmann::json& training) const;
