@@ -159,6 +159,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     p.threads = o.threads;
     p.delay_aware = o.delay_aware;
     p.anneal_lr = o.anneal_lr;
+    p.bootstrap_success = !o.terminal_success;
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
     const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
@@ -176,6 +177,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
           << " --eval-episodes " << o.eval_episodes;
       if (o.delay_aware) cmd << " --delay-aware";
       if (o.anneal_lr) cmd << " --anneal-lr";
+      if (o.terminal_success) cmd << " --terminal-success";
       return cmd.str();
     };
     nlohmann::json provenance = {
@@ -199,6 +201,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
         {"init_log_std", p.init_log_std}};
     if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", {0, 1, 2, 4}}};
     if (o.anneal_lr) provenance["anneal_lr"] = true;
+    provenance["success"] = o.terminal_success ? "terminal" : "bootstrapped with the critic's value of the final observation";
     const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;
     const std::int64_t iterations = std::max<std::int64_t>(1, o.total_steps / per_iter);
     err << "train ppo: " << o.task << (o.delay_aware ? " (delay-aware)" : "") << ", layers "

@@ -50,7 +50,8 @@ struct TrainPpoOptions {
   std::string curve;                // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
   std::string progress{"auto"};     // --progress auto|bar|lines|off
   bool delay_aware{false};          // --delay-aware (observation ++ last 4 actions, lags {0,1,2,4})
-  bool anneal_lr{false};            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
+  bool anneal_lr{false};
+  bool terminal_success{false};     // --terminal-success (value 0 after a success; earlier releases)            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
 };
 int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

@@ -139,6 +139,11 @@ std::vector<int> sizes_of(int in, const std::vector<int>& hidden, int out) {
 
 }  // namespace
 
+bool bootstraps(bool success, bool truncated, sim::SafetyFlag safety, bool bootstrap_success) {
+  if (safety != sim::SafetyFlag::kNone) return false;  // a safety stop is terminal
+  return success ? bootstrap_success : truncated;
+}
+
 Eigen::VectorXf gae(const Eigen::VectorXf& rewards, const Eigen::VectorXf& values, const Eigen::VectorXf& final_values,
                     const std::vector<std::uint8_t>& ended, const Eigen::VectorXf& next_value, int num_envs, double gamma,
                     double lambda) {
@@ -380,7 +385,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
   std::vector<std::uint8_t> ended(static_cast<std::size_t>(per_iter));
   // per-env results of one step, written by the workers by env index
   std::vector<float> step_reward(static_cast<std::size_t>(n_env));
-  std::vector<std::uint8_t> step_end(static_cast<std::size_t>(n_env)), step_trunc(static_cast<std::size_t>(n_env)),
+  std::vector<std::uint8_t> step_end(static_cast<std::size_t>(n_env)), step_boot(static_cast<std::size_t>(n_env)),
       step_success(static_cast<std::size_t>(n_env));
   std::vector<double> step_return(static_cast<std::size_t>(n_env));
   Eigen::MatrixXf final_obs(obs_dim, n_env);
@@ -418,8 +423,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
           const bool over = r.episode_over();
           step_success[ue] = success ? 1 : 0;
           step_end[ue] = (success || over) ? 1 : 0;
-          // time limit without success: bootstrap; success or a safety stop: terminal
-          step_trunc[ue] = (!success && r.truncated && r.safety == sim::SafetyFlag::kNone) ? 1 : 0;
+          step_boot[ue] = bootstraps(success, r.truncated, r.safety, o.bootstrap_success) ? 1 : 0;
           // next network input: the observation, and (delay-aware) the history shifted by the executed action
           Eigen::VectorXf next(obs_dim);
           next.head(env_obs_dim) = r.obs.cast<float>();
@@ -437,22 +441,22 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
         }
       });
       pool.join();
-      bool any_trunc = false;
+      bool any_boot = false;
       for (int e = 0; e < n_env; ++e) {
         const auto ue = static_cast<std::size_t>(e);
         rewards(base + e) = step_reward[ue];
         ended[static_cast<std::size_t>(base + e)] = step_end[ue];
-        any_trunc = any_trunc || step_trunc[ue];
+        any_boot = any_boot || step_boot[ue];
         if (step_end[ue]) {
           ++rec.episodes;
           rec.successes += step_success[ue];
           return_sum += step_return[ue];
         }
       }
-      if (any_trunc) {
+      if (any_boot) {
         const Eigen::VectorXf fv = learner.value(final_obs);
         for (int e = 0; e < n_env; ++e)
-          final_values(base + e) = step_trunc[static_cast<std::size_t>(e)] ? fv(e) : 0.0f;
+          final_values(base + e) = step_boot[static_cast<std::size_t>(e)] ? fv(e) : 0.0f;
       } else {
         final_values.segment(base, n_env).setZero();
       }

@@ -142,6 +142,18 @@ TEST(PpoTrain, AnnealedLearningRateStartsAtTheSetRateAndThenDeparts) {
   EXPECT_NE(plain[1].w.front(), annealed[1].w.front());
 }
 
+TEST(PpoTrain, SuccessIsBootstrappedAsManiSkillDoesUnlessTerminalIsAsked) {
+  using sim::SafetyFlag;
+  EXPECT_TRUE(policy::bootstraps(true, false, SafetyFlag::kNone, true));    // success, ManiSkill
+  EXPECT_FALSE(policy::bootstraps(true, false, SafetyFlag::kNone, false));  // success, terminal
+  EXPECT_TRUE(policy::bootstraps(true, true, SafetyFlag::kNone, true));     // success at the time limit
+  EXPECT_TRUE(policy::bootstraps(false, true, SafetyFlag::kNone, false));   // time limit
+  EXPECT_TRUE(policy::bootstraps(false, true, SafetyFlag::kNone, true));
+  EXPECT_FALSE(policy::bootstraps(false, false, SafetyFlag::kWorkspaceViolation, true));  // safety stop
+  EXPECT_FALSE(policy::bootstraps(false, true, SafetyFlag::kWorkspaceViolation, true));
+  EXPECT_FALSE(policy::bootstraps(true, false, SafetyFlag::kWorkspaceViolation, true));
+}
+
 TEST(PpoTrain, RejectsNonPositiveSizes) {
   auto o = tiny(1);
   o.num_envs = 0;

@@ -13,7 +13,7 @@
 /// initialisation (gain sqrt 2, actor output 0.01 sqrt 2, critic output 1), a state-independent
 /// log standard deviation initialised at -0.5, normalized dense reward, partial resets (an env that
 /// succeeds terminates and is reset alone; a time-limit truncation bootstraps with the critic's value
-/// of the final observation). What does not transfer (4096 GPU environments x 4 steps per rollout)
+/// of the final observation, and so does a success, as ManiSkill's ppo.py does). What does not transfer (4096 GPU environments x 4 steps per rollout)
 /// is scaled to a CPU: fewer environments, more steps per rollout, minibatches of about the same
 /// size (docs/backbones.md, "PPO").
 ///
@@ -23,6 +23,7 @@
 /// chunk gradients, computed in parallel.
 
 #include "actionshift/policy/mlp.hpp"
+#include "actionshift/sim/env.hpp"
 
 #include <Eigen/Core>
 
@@ -63,6 +64,13 @@ struct PpoOptions {
   /// that lag). The frozen backbone carries history = kHistoryLength (backbone `ppo-delay-aware`);
   /// evaluations split their episodes over the four lags.
   bool delay_aware{false};
+  /// Bootstrap an episode that ends in success with the critic's value of its final observation, as
+  /// ManiSkill's ppo.py does for every finished episode (its `final_values` cover terminations and
+  /// truncations alike). false: success is terminal (value 0 after it), which with the normalized
+  /// dense reward and gamma 0.8 pays more for hovering just short of the goal (about 0.6 per step,
+  /// 3 in value) than for succeeding (1, then nothing): the earlier releases' setting, kept to
+  /// reproduce their weights. A safety stop (this project's, ManiSkill has none) is always terminal.
+  bool bootstrap_success{true};
   /// Anneal the learning rate linearly to 0 over the run (ManiSkill ppo.py's `anneal_lr`).
   bool anneal_lr{false};
 };
@@ -100,6 +108,11 @@ struct PpoUpdateStats {
   double policy_loss{0.0}, value_loss{0.0}, approx_kl{0.0}, clip_fraction{0.0};
   int epochs{0};
 };
+
+/// Whether an episode that ended at this step is bootstrapped with the critic's value of its final
+/// observation (GAE's `final_values`): a time limit yes, a success when `bootstrap_success`
+/// (ManiSkill), a safety stop never.
+bool bootstraps(bool success, bool truncated, sim::SafetyFlag safety, bool bootstrap_success);
 
 /// Generalised advantage estimation over a rollout stored time-major (index t * num_envs + e).
 /// `ended[k]`: the episode ended at step k (the next stored step of that env is a new episode);
