@@ -116,6 +116,32 @@ TEST(MlpPolicy, HistoryHoldsTheLastFourActionsMostRecentFirst) {
   EXPECT_EQ(p.name(), "mlp-delay-aware");
 }
 
+TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsBackbone) {
+  std::ifstream sums(ACTIONSHIFT_SOURCE_DIR "/configs/backbones/SHA256SUMS");
+  std::map<std::string, std::string> listed;
+  for (std::string sha, file; sums >> sha >> file;) listed[file] = sha;
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(ACTIONSHIFT_SOURCE_DIR "/configs/backbones")) {
+    const std::string name = entry.path().filename().string();
+    if (!name.ends_with(".asmlp")) continue;
+    ++files;
+    std::ifstream f(entry.path(), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(listed[name], sha256_hex(bytes)) << name << " vs SHA256SUMS";
+    // <task>.<backbone>.asmlp loads through the registry as that backbone, for that task
+    const std::string stem = name.substr(0, name.size() - 6);
+    const auto dot = stem.find('.');
+    ASSERT_NE(dot, std::string::npos) << name;
+    const sim::TaskId task = sim::parse_task(stem.substr(0, dot));
+    policy::RegistryOptions ro;
+    ro.backbones_dir = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
+    auto p = policy::make_policy(stem.substr(dot + 1), task, ro);
+    EXPECT_EQ(p->task(), task) << name;
+    EXPECT_EQ(p->sha256(), sha256_hex(bytes)) << name;
+  }
+  EXPECT_EQ(files, static_cast<int>(listed.size()));
+}
+
 TEST(MlpBackbones, CommittedWeightsHaveTheirDocumentedLayersAndChecksums) {
   // docs/backbones.md: 2 x 512 tanh for pick_cube (chosen on a pilot seed), 2 x 256 for the others
   std::ifstream sums(ACTIONSHIFT_SOURCE_DIR "/configs/backbones/SHA256SUMS");
