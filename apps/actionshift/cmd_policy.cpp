@@ -160,6 +160,8 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     p.delay_aware = o.delay_aware;
     p.anneal_lr = o.anneal_lr;
     p.bootstrap_success = !o.terminal_success;
+    if (o.stop_after < 0) throw InputError("", "stop-after", "must be non-negative");
+    p.stop_steps = o.stop_after;
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
     const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
@@ -167,17 +169,22 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     const std::string curve_path = o.curve.empty() ? stem + ".curve.jsonl" : o.curve;
     std::ofstream curve(curve_path, std::ios::trunc);
     if (!curve) throw InputError(curve_path, "", "cannot write the training curve");
-    // the command that reproduces a run of `steps` environment steps (a checkpoint names its own)
-    auto command = [&o](std::int64_t steps) {
+    // the command that reproduces a run of `steps` environment steps (a checkpoint names its own): the
+    // total steps themselves, or, when the learning-rate schedule depends on the total (--anneal-lr),
+    // the same total and --stop-after
+    const std::int64_t full_steps = std::max<std::int64_t>(1, o.total_steps / (static_cast<std::int64_t>(o.envs) * o.rollout_steps)) *
+                                    o.envs * o.rollout_steps;
+    auto command = [&o, full_steps](std::int64_t steps) {
       std::ostringstream cmd;
       cmd << "actionshift train ppo --task " << o.task << " --profile " << o.profile << " --seed " << o.seed << " --total-steps "
-          << steps << " --envs " << o.envs << " --rollout-steps " << o.rollout_steps << " --minibatches " << o.minibatches
+          << (o.anneal_lr ? o.total_steps : steps) << " --envs " << o.envs << " --rollout-steps " << o.rollout_steps << " --minibatches " << o.minibatches
           << " --epochs " << o.epochs << " --lr " << o.learning_rate << " --gamma " << o.gamma << " --gae-lambda " << o.gae_lambda
           << " --target-kl " << o.target_kl << " --hidden " << o.hidden << " --eval-every " << o.eval_every
           << " --eval-episodes " << o.eval_episodes;
       if (o.delay_aware) cmd << " --delay-aware";
       if (o.anneal_lr) cmd << " --anneal-lr";
       if (o.terminal_success) cmd << " --terminal-success";
+      if (o.anneal_lr && steps < full_steps) cmd << " --stop-after " << steps;
       return cmd.str();
     };
     nlohmann::json provenance = {

@@ -51,7 +51,8 @@ struct TrainPpoOptions {
   std::string progress{"auto"};     // --progress auto|bar|lines|off
   bool delay_aware{false};          // --delay-aware (observation ++ last 4 actions, lags {0,1,2,4})
   bool anneal_lr{false};
-  bool terminal_success{false};     // --terminal-success (value 0 after a success; earlier releases)            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
+  bool terminal_success{false};
+  std::int64_t stop_after{0};       // --stop-after STEPS (0: none)     // --terminal-success (value 0 after a success; earlier releases)            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
 };
 int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

@@ -240,6 +240,9 @@ int main(int argc, char** argv) {
                 "Delay-aware PPO (the long-lag solve): the networks also see the last 4 executed actions and each\n"
                 "training episode runs under a lag drawn from {0, 1, 2, 4}; writes <task>.ppo-delay-aware.asmlp");
   ppo->add_flag("--anneal-lr", ppo_o.anneal_lr, "Anneal the learning rate linearly to 0 over the run");
+  ppo->add_option("--stop-after", ppo_o.stop_after,
+                  "End the run after this many environment steps (the learning-rate schedule still spans\n"
+                  "--total-steps): how an annealed run's checkpoint is reproduced");
   ppo->add_flag("--terminal-success", ppo_o.terminal_success,
                 "Treat a success as terminal (value 0 after it) instead of bootstrapping it with the critic, as\n"
                 "ManiSkill's ppo.py does; the setting of earlier releases (rewards hovering short of the goal)");

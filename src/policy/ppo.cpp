@@ -475,7 +475,8 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
     rec.clip_fraction = us.clip_fraction;
     rec.epochs = us.epochs;
     rec.mean_std = learner.log_std().array().exp().mean();
-    const bool last_it = it + 1 == iterations;
+    const bool stopping = o.stop_steps > 0 && env_steps >= o.stop_steps;
+    const bool last_it = it + 1 == iterations || stopping;
     if (o.eval_episodes > 0 && (last_it || (o.eval_every > 0 && (it + 1) % o.eval_every == 0))) {
       nlohmann::json tr = provenance;
       tr["env_steps"] = env_steps;
@@ -517,10 +518,11 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
     rec.seconds = elapsed();
     result.iterations.push_back(rec);
     if (progress) progress(rec);
+    if (stopping) break;
   }
   nlohmann::json tr = provenance;
   tr["env_steps"] = env_steps;
-  tr["iterations"] = iterations;
+  tr["iterations"] = static_cast<int>(result.iterations.size());
   result.wall_seconds = elapsed();
   if (!result.iterations.empty() && result.iterations.back().eval_success >= 0) {
     tr["eval_success_once"] = result.iterations.back().eval_success;

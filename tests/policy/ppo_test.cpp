@@ -142,6 +142,25 @@ TEST(PpoTrain, AnnealedLearningRateStartsAtTheSetRateAndThenDeparts) {
   EXPECT_NE(plain[1].w.front(), annealed[1].w.front());
 }
 
+TEST(PpoTrain, StopAfterReproducesAnAnnealedRunsCheckpoint) {
+  auto o = tiny(1);
+  o.anneal_lr = true;
+  o.total_steps = 128;  // 4 iterations, annealed over 4
+  std::vector<policy::MlpWeights> ck;
+  policy::train_ppo(o, {}, {}, [&ck](const policy::MlpWeights& w) { ck.push_back(w); });
+  ASSERT_EQ(ck.size(), 4u);
+  o.stop_steps = 64;  // stop after iteration 2, the schedule still over 4
+  const auto stopped = policy::train_ppo(o, {});
+  EXPECT_EQ(stopped.iterations.size(), 2u);
+  EXPECT_EQ(stopped.actor.training.at("env_steps"), 64);
+  EXPECT_EQ(stopped.actor.training.at("iterations"), 2);
+  for (std::size_t i = 0; i < ck[1].w.size(); ++i) EXPECT_EQ(stopped.actor.w[i], ck[1].w[i]) << i;
+  // a run of 64 total steps anneals faster: not the same weights
+  o.stop_steps = 0;
+  o.total_steps = 64;
+  EXPECT_NE(policy::train_ppo(o, {}).actor.w.front(), ck[1].w.front());
+}
+
 TEST(PpoTrain, SuccessIsBootstrappedAsManiSkillDoesUnlessTerminalIsAsked) {
   using sim::SafetyFlag;
   EXPECT_TRUE(policy::bootstraps(true, false, SafetyFlag::kNone, true));    // success, ManiSkill

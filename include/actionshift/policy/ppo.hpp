@@ -73,6 +73,10 @@ struct PpoOptions {
   bool bootstrap_success{true};
   /// Anneal the learning rate linearly to 0 over the run (ManiSkill ppo.py's `anneal_lr`).
   bool anneal_lr{false};
+  /// End the run after the first iteration that reaches this many environment steps (0: run to
+  /// total_steps). The learning-rate schedule still spans total_steps, so an annealed run's checkpoint
+  /// is reproduced by the same total_steps plus stop_steps = its step count.
+  std::int64_t stop_steps{0};
 };
 
 /// One training iteration (rollout + update).
