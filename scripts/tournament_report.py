@@ -5,7 +5,9 @@
 cell beside the paper's Table 5 (tournament) and Table 3 (DualABI vs entropy) and marks each of the
 paper's findings reproduced, contradicted or untestable by a rule stated on the page.
 Standard library only.
-usage: scripts/tournament_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS > docs/results/tournament.md"""
+With PPO_DIR (the `tournament_ppo` results of `LEARNED=ppo scripts/learned_backbone`), the reference cells
+with the PPO backbone, the paper's own kind, are set beside the expert's and every finding is tested on both.
+usage: scripts/tournament_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS [PPO_DIR] > docs/results/tournament.md"""
 import glob
 import json
 import os
@@ -13,6 +15,7 @@ import subprocess
 import sys
 
 results, binary, wall = sys.argv[1], sys.argv[2], sys.argv[3]
+ppo_dir = sys.argv[4] if len(sys.argv) > 4 and os.path.isdir(sys.argv[4]) else None
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 summary = json.loads(subprocess.run([binary, "summarize", results, "--json"], check=True, capture_output=True, text=True).stdout)
 cells = summary["cells"]
@@ -21,6 +24,13 @@ promos = {}
 for path in glob.glob(os.path.join(results, "promotion.*.json")):
     v = json.load(open(path))
     promos[(v["candidate"], v["baseline"])] = v
+by_ppo, promos_ppo = {}, {}
+if ppo_dir:
+    ppo_summary = json.loads(subprocess.run([binary, "summarize", ppo_dir, "--json"], check=True, capture_output=True, text=True).stdout)
+    by_ppo = {(c["task"], c["split"], c["method"]): c for c in ppo_summary["cells"] if c["backbone"] == "ppo"}
+    for path in glob.glob(os.path.join(ppo_dir, "promotion.*.json")):
+        v = json.load(open(path))
+        promos_ppo[(v["candidate"], v["baseline"])] = v
 jobs = set()
 for c in cells:
     jobs.update(c["jobs"])
@@ -58,11 +68,12 @@ def cell_line(task, split, m):
             f"{c['mean_probe_steps']:.2f} | {paper_probe} | {c['mean_probe_displacement']:.4f} | {flags} |")
 
 
-def diff(c, b, task, split):
-    v = promos.get((c, b))
+def diff(c, b, task, split, table=None):
+    v = (promos if table is None else table).get((c, b))
     if not v:
         return None
-    cell = v["cells"].get(f"{task}/{split}")
+    # a cell key names its backbone when it is not the expert (`gate promote`)
+    cell = v["cells"].get(f"{task}/{split}") or v["cells"].get(f"{task}/{split}/ppo")
     return None if not cell else cell
 
 
@@ -79,7 +90,9 @@ print("- Paper columns: the paper's Table 5 (and Table 2 for oracle / no_adapt):
       " (Stack: one seed, 200). The paper's \"seen\", \"unseen comp.\" and \"long lag\" are our `reference_*` splits (the same six"
       " contracts); the generated splits have no paper counterpart.")
 print("- The `ideal` profile's earlier tournament (previous calibration protocol) is kept in docs/results/tournament_ideal.md.")
-print("- The reference cells with the learned (imitation MLP) backbone beside the expert: docs/results/learned_backbone.md.\n")
+print("- The reference cells with the learned backbones beside the expert: docs/results/learned_backbone.md (imitation MLP) and"
+      " docs/results/learned_backbone_ppo.md (PPO)" + (f"; the PPO cells on this page come from `{os.path.relpath(os.path.abspath(ppo_dir), ROOT)}`"
+      if ppo_dir else "") + ".\n")
 print("Success is success_once with its Wilson 95 % interval over the seeds; probe = mean probe steps per episode;"
       " disp. = mean TCP translation during probes [m].\n")
 
@@ -110,9 +123,10 @@ print(f"Reading: on `reference_seen` with the nine-contract pool every belief me
 print(f"calibrations follow the reference's protocol as it runs in ManiSkill (`{cal.get('protocol', '?')}`; PickCube mean R² "
       f"{sum(cal['fit_r2']) / 6:.2f}, per-step alpha/sigma {min(snr):.1f}-{max(snr):.1f}, against 0.23 and about 1 in the paper's")
 print("ManiSkill calibration; docs/sim.md), so each belief update is about as weak as the paper's. The likely difference is")
-print("the backbone (untested until a PPO backbone passes Gate 0 on Pick): the closed-loop scripted expert replans from the state it finds, so the few steps a belief spends on a")
+print("the backbone: the closed-loop scripted expert replans from the state it finds, so the few steps a belief spends on a")
 print("wrong contract cost it little, where the paper's frozen PPO policies lose up to 7 points. The brittleness page")
-print("([`brittleness.md`](brittleness.md)) runs the same adapters with the imitation MLP. Elsewhere the methods do separate:")
+print("([`brittleness.md`](brittleness.md)) runs the same adapters with the learned backbones; the PPO backbone's reference")
+print("cells are the next section. With the expert, elsewhere the methods do separate:")
 sep = []
 for split in ref_splits + gen_splits:
     for task in tasks:
@@ -130,6 +144,52 @@ print("[`noise_sensitivity.md`](noise_sensitivity.md): pick_cube / reference_see
 print("oracle and no_adapt under the explicit, off-by-default sensor-noise knob (`run --obs-noise SIGMA`, docs/sim.md §6.1)")
 print("at a grid of noise levels fixed before the run, each with the calibration measured under the same noise and with the")
 print("built-in one, paired differences by the same bootstrap as here. The tables on this page stay noise-free.\n")
+
+# ---- the PPO backbone's reference cells
+BELIEF5 = ["exact_belief", "fixed_probes", "random_probes", "entropy_probes", "dualabi"]
+print("## The reference cells with the PPO backbone\n")
+ppo_tasks = sorted({t for (t, _, _) in by_ppo}, key=tasks.index) if by_ppo else []
+if not ppo_tasks:
+    print("Not run here (no PPO results directory was given to the report).\n")
+else:
+    missing = [t for t in ("pick_cube", "push_cube", "pull_cube") if t not in ppo_tasks]
+    print("The same cells (the paper's frozen splits, `reference9`, 3 seeds x 200 episodes, live rotation) with the frozen PPO")
+    print("backbones trained here (`train ppo`, docs/backbones.md) in place of the expert: the paper's own kind of backbone."
+          + (f" No PPO backbone passes Gate 0 on {', '.join(missing)}, so those cells are not run." if missing else ""))
+    print("Spread = max - min over the five pool-belief methods; paired differences by `actionshift gate promote` on the PPO")
+    print("records (an interval that excludes 0 separates the pair); the paper's difference beside each.\n")
+    print("| task | split | oracle | belief-family spread (lowest to highest) | paper spread | entropy - exact [95 %] | paper | DualABI - exact [95 %] | paper | expert spread |")
+    print("|---|---|---|---|---:|---|---:|---|---:|---:|")
+    ppo_sep = []
+    for task in ppo_tasks:
+        for split in ("reference_seen", "reference_unseen_composition"):
+            rs = {m: by_ppo[(task, split, m)]["success_once"]["rate"] for m in BELIEF5 if (task, split, m) in by_ppo}
+            if not rs:
+                continue
+            lo, hi = min(rs, key=rs.get), max(rs, key=rs.get)
+            pr = [P[(task, split, m)][0] for m in BELIEF5 if (task, split, m) in P]
+            er = [by[(task, split, m)]["success_once"]["rate"] for m in BELIEF5 if (task, split, m) in by]
+            o = by_ppo.get((task, split, "oracle"))
+
+            def dtext(c, b):
+                d = diff(c, b, task, split, promos_ppo)
+                if not d:
+                    return "—"
+                e = d["difference"]
+                return f"{e['estimate']:+.3f} [{e['lower']:+.3f}, {e['upper']:+.3f}]" + (" **excl. 0**" if e["lower"] > 0 or e["upper"] < 0 else "")
+
+            def pdiff(c, b):
+                return f"{P[(task, split, c)][0] - P[(task, split, b)][0]:+.3f}" if (task, split, c) in P and (task, split, b) in P else "—"
+            print(f"| {task} | {split} | {f3(o['success_once']['rate'] if o else None)} | {rs[hi] - rs[lo]:.3f} ({lo} {rs[lo]:.3f} to {hi} {rs[hi]:.3f}) | "
+                  f"{f3(max(pr) - min(pr) if pr else None)} | {dtext('entropy_probes', 'exact_belief')} | {pdiff('entropy_probes', 'exact_belief')} | "
+                  f"{dtext('dualabi', 'exact_belief')} | {pdiff('dualabi', 'exact_belief')} | {f3(max(er) - min(er) if er else None)} |")
+            ppo_sep.append((task, split, rs[hi] - rs[lo], max(er) - min(er) if er else None))
+    print()
+    wide = [f"{t}/{sp} {a:.3f} (expert {f3(b)})" for t, sp, a, b in ppo_sep]
+    print("Reading: with the PPO backbone the belief-family spreads are " + ", ".join(wide) + ". The methods that tie with the")
+    print("expert separate with a frozen PPO policy: a belief that decodes a few steps under a wrong contract leaves the PPO in")
+    print("states it never saw in training, where the replanning expert recovers. The ordering of the methods is a finding of")
+    print("its own, tested against the paper's in the next section.\n")
 
 # ---- findings
 print("## The paper's findings, tested\n")
@@ -150,12 +210,30 @@ findings = [
     ("DualABI ties entropy probing on success, Push/unseen (+0.7 [-0.3, +1.8])", "dualabi", "entropy_probes", "push_cube", "reference_unseen_composition", "tie"),
     ("DualABI beats fixed probes on Pick/seen (+5.5 [+3.2, +7.8])", "dualabi", "fixed_probes", "pick_cube", "reference_seen", "pos"),
 ]
-print("| finding (paper) | ours: candidate / baseline | ours: paired difference [95 %] | status | reason |")
-print("|---|---|---|---|---|")
+print("| finding (paper) | expert: candidate / baseline | expert: paired difference [95 %] | expert: status | reason | PPO: candidate / baseline | PPO: paired difference [95 %] | PPO: status |")
+print("|---|---|---|---|---|---|---|---|")
+
+
+def judge(d, kind):
+    e = d["difference"]
+    lo, hi = e["lower"], e["upper"]
+    return (kind == "pos" and lo > 0) or (kind == "neg" and hi < 0) or (kind == "tie" and lo <= 0 <= hi)
+
+
+def ppo_cols(c, b, task, split, kind):
+    d = diff(c, b, task, split, promos_ppo)
+    if d is None:
+        return "— | — | untestable (no PPO cell)"
+    e = d["difference"]
+    ok = judge(d, kind)
+    return (f"{d['candidate_success']:.3f} / {d['baseline_success']:.3f} | {e['estimate']:+.3f} [{e['lower']:+.3f}, {e['upper']:+.3f}] | "
+            f"**{'reproduced' if ok else 'contradicted'}**")
+
+
 for text, c, b, task, split, kind in findings:
     d = diff(c, b, task, split)
     if d is None:
-        print(f"| {text} | — | — | untestable | cell not run |")
+        print(f"| {text} | — | — | untestable | cell not run | {ppo_cols(c, b, task, split, kind)} |")
         continue
     e = d["difference"]
     lo, hi = e["lower"], e["upper"]
@@ -171,30 +249,44 @@ for text, c, b, task, split, kind in findings:
         else:
             reason = f"our interval [{lo:+.3f}, {hi:+.3f}] does not support it ({cs:.3f} vs {bs:.3f})"
     print(f"| {text} | {d['candidate_success']:.3f} / {d['baseline_success']:.3f} | {e['estimate']:+.3f} [{lo:+.3f}, {hi:+.3f}] | "
-          f"**{'reproduced' if ok else 'contradicted'}** | {reason} |")
+          f"**{'reproduced' if ok else 'contradicted'}** | {reason} | {ppo_cols(c, b, task, split, kind)} |")
 # probe-cost finding (Table 3 aggregate)
-agg = {"dualabi": [0, 0, 0, 0.0], "entropy_probes": [0, 0, 0, 0.0]}
-for m in agg:
-    for task in ("pick_cube", "push_cube"):
-        for split in ("reference_seen", "reference_unseen_composition"):
-            c = by.get((task, split, m))
-            if c:
-                agg[m][0] += c["success_once"]["successes"]; agg[m][1] += c["episodes"]
-                agg[m][2] += c["mean_probe_steps"] * c["episodes"]; agg[m][3] += c["mean_probe_displacement"] * c["episodes"]
-if agg["dualabi"][1] and agg["entropy_probes"][1]:
-    dp = agg["dualabi"][2] / agg["dualabi"][1]; ep = agg["entropy_probes"][2] / agg["entropy_probes"][1]
-    dd = agg["dualabi"][3] / agg["dualabi"][1]; ed = agg["entropy_probes"][3] / agg["entropy_probes"][1]
-    ok = dp < ep
+def probe_agg(table):
+    """(DualABI steps, entropy steps, DualABI displacement, entropy displacement) over Pick/Push seen/unseen."""
+    agg = {"dualabi": [0, 0.0, 0.0], "entropy_probes": [0, 0.0, 0.0]}
+    for m in agg:
+        for task in ("pick_cube", "push_cube"):
+            for split in ("reference_seen", "reference_unseen_composition"):
+                c = table.get((task, split, m))
+                if c:
+                    agg[m][0] += c["episodes"]
+                    agg[m][1] += c["mean_probe_steps"] * c["episodes"]
+                    agg[m][2] += c["mean_probe_displacement"] * c["episodes"]
+    if not agg["dualabi"][0] or not agg["entropy_probes"][0]:
+        return None
+    a, e = agg["dualabi"], agg["entropy_probes"]
+    return a[1] / a[0], e[1] / e[0], a[2] / a[0], e[2] / e[0]
+
+
+def probe_text(x):
+    dp, ep, dd, ed = x
+    return f"{dp:.2f} vs {ep:.2f} steps ({(dp / ep - 1) * 100:+.0f} %); {dd:.4f} vs {ed:.4f} m ({(dd / ed - 1) * 100:+.0f} %)"
+
+
+pe, pp = probe_agg(by), probe_agg(by_ppo)
+if pe:
+    ok = pe[0] < pe[1]
+    ppo_part = "— | — | untestable (no PPO cell)" if not pp else f"{probe_text(pp)} | — | **{'reproduced' if pp[0] < pp[1] else 'contradicted'}**"
     print(f"| DualABI uses fewer probe steps than entropy probing (Table 3 aggregate over Pick/Push seen/unseen: 2.89 vs 6.00, -52 %;"
-          f" displacement 0.0154 vs 0.0267 m, -42 %) | {dp:.2f} vs {ep:.2f} steps ({(dp / ep - 1) * 100:+.0f} %); {dd:.4f} vs {ed:.4f} m"
-          f" ({(dd / ed - 1) * 100:+.0f} %) | — | **{'reproduced' if ok else 'contradicted'}** | {'' if ok else 'DualABI probed as much as entropy'} |")
+          f" displacement 0.0154 vs 0.0267 m, -42 %) | {probe_text(pe)} | — | **{'reproduced' if ok else 'contradicted'}** |"
+          f" {'' if ok else 'DualABI probed as much as entropy'} | {ppo_part} |")
 ll = [by.get((t, "reference_long_lag", m)) for t in tasks for m in methods if m not in ("oracle", "no_adapt")]
 ll = [c for c in ll if c]
 if ll:
     top = max(c["success_once"]["rate"] for c in ll)
     orc = max((by[(t, "reference_long_lag", "oracle")]["success_once"]["rate"] for t in tasks if (t, "reference_long_lag", "oracle") in by), default=None)
     print(f"| no pool-belief method solves long lag (paper: 0.02-0.33, at the oracle's own low level) | best belief method {top:.3f};"
-          f" best oracle {f3(orc)} | — | **{'reproduced' if top <= 0.5 else 'contradicted'}** | |")
+          f" best oracle {f3(orc)} | — | **{'reproduced' if top <= 0.5 else 'contradicted'}** | | — | — | not run with PPO (its long-lag cells are docs/results/long_lag.md) |")
 print()
 
 for split in ref_splits + gen_splits:
