@@ -32,7 +32,9 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
   if (backbone == "mlp" || backbone == "mlp-delay-aware" || backbone.starts_with("mlp:")) {
     const std::string path = backbone.starts_with("mlp:") ? std::string(backbone.substr(4))
                                                           : mlp_weights_path(backbone, task, options.backbones_dir);
-    auto p = MlpPolicy::from_file(path);
+    // a file given by path keeps its `mlp:<path>` name, so a job planned with it loads the same file
+    // when it runs (the name is how the runner rebuilds the backbone; the SHA-256 checks the bytes)
+    auto p = MlpPolicy::from_file(path, backbone.starts_with("mlp:") ? std::string(backbone) : std::string());
     if (p->task() != task)
       throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
                                          std::string(sim::task_name(task)));
