@@ -125,9 +125,13 @@ for task in tasks:
     if os.path.exists(g0):
         v = next(iter(json.load(open(g0))["cells"].values()))
         i = v["competence"]["interval"]
-        print(f"- The `ppo` backbone on {task} is **{v['decision']}** at Gate 0 ({i['rate']:.3f} over {i['total']} episodes,"
-              " configs/gates/gate0/): a weak backbone, shown because the collapse-and-restore pattern is about the")
-        print("  interface, not the backbone's skill; its cells are not a competent-PPO result (docs/backbones.md, PPO).")
+        if v["decision"] == "advance":
+            print(f"- The `ppo` backbone on {task} is **advance** at Gate 0 ({i['rate']:.3f} over {i['total']} episodes,"
+                  " configs/gates/gate0/): a competent frozen PPO, the paper's own kind of backbone.")
+        else:
+            print(f"- The `ppo` backbone on {task} is **{v['decision']}** at Gate 0 ({i['rate']:.3f} over {i['total']} episodes,"
+                  " configs/gates/gate0/): a weak backbone, shown because the collapse-and-restore pattern is about the")
+            print("  interface, not the backbone's skill; its cells are not a competent-PPO result (docs/backbones.md, PPO).")
 gb = [f"{bb} {cells[(bb, t, 'grammar_belief')][0] / cells[(bb, t, 'grammar_belief')][1]:.3f} ({t})"
       for t in tasks for bb, _ in BACKBONES if (bb, t, "grammar_belief") in cells]
 print("- The grammar belief (its reference operating point: no pulse probes, hold probes, no pool), per backbone:")

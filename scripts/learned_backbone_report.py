@@ -82,7 +82,10 @@ if LEARNED == "ppo":
     print("frozen *learned* policies, PPO among them. This page re-runs Gate 1 and the tournament's reference cells with")
     print("the PPO backbones trained here (`train ppo`, docs/backbones.md; Gate 0 in docs/results/gate0.md), the paper's")
     print("own kind of backbone, and sets them beside the expert's cells of the same experiments. The imitation MLP's")
-    print("page is docs/results/learned_backbone.md. stack_cube is left out: no PPO backbone passes Gate 0 there.\n")
+    missing = [t for t in TASKS if not any(k[0] == t for k in list(g_mlp) + list(t_mlp))]
+    print("page is docs/results/learned_backbone.md. stack_cube is left out" + (f", and so is {', '.join(missing)} (its rows are"
+          " dashes)" if missing else "") + ": no PPO backbone passes Gate 0 there within this release's training budget"
+          " (docs/backbones.md).\n")
 else:
     print("frozen *learned* policies. This page re-runs Gate 1 and the tournament's reference cells with the imitation")
     print("backbone that passes Gate 0 on the tasks (the DAgger-trained MLP, docs/backbones.md) and sets it beside the")
