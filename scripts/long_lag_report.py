@@ -158,9 +158,10 @@ for task in ("pick_cube", "push_cube"):
         print(f"- {task}: the delay-aware PPO solves the long lag through oracle-encode ({rate(o_)[0]:.3f}) but not through the passive"
               f" exact belief ({rate(b_)[0]:.3f}, below the reactive PPO's {rate(a_)[0]:.3f}: {d[0]:+.3f} [{d[1]:+.3f}, {d[2]:+.3f}]),"
               " where the paper's delay-aware PPO keeps most of its gain (0.387 against 0.415). The delay-aware expert and MLP keep")
-        print("  theirs. Not explained here; a candidate: the network reads its own last four actions as the delayed pipeline,")
-        print("  and while the belief is still wrong the executed actions are not those, a history its training never showed it")
-        print("  (under the oracle, and in training, emitted and executed actions always agree up to the lag).")
+        print("  theirs. The same collapse shows without any lag (docs/backbones.md, delay-aware PPO), as it does for the")
+        print("  reference implementation's delay-aware PPO on Push/seen (its write-up: oracle 0.990, exact belief 0.370, probing")
+        print("  0.02-0.05); a candidate cause: the network reads its own last four actions as the delayed pipeline, and while")
+        print("  the belief is still wrong the executed actions are not those, a history its training never showed it.")
 print("- The delay-aware MLP is trained by DAgger from the delay-aware expert (an imitation student, not the paper's PPO);")
 print("  where it sits below its teacher, that gap is the student's (docs/results/gate0.md has its lag-free Gate 0).\n")
 print("## Lag 4 on its own\n")
