@@ -206,7 +206,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
         {"max_grad_norm", p.max_grad_norm},
         {"target_kl", o.target_kl},
         {"init_log_std", p.init_log_std}};
-    if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", {0, 1, 2, 4}}};
+    if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", policy::kTrainingLags}};
     if (o.anneal_lr) provenance["anneal_lr"] = true;
     provenance["success"] = o.terminal_success ? "terminal" : "bootstrapped with the critic's value of the final observation";
     const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;

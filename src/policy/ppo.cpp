@@ -26,7 +26,6 @@ namespace {
 
 constexpr std::uint64_t kPpoStream = 0x7070'6f00'0000'0000ULL;  // keeps PPO seeds apart from evaluation seeds
 constexpr int kGradChunks = 8;  // a minibatch gradient is the ordered sum of this many chunk gradients
-constexpr int kLags[] = {0, 1, 2, 4};  // training lags of the delay-aware run (reference section 13)
 const float kLogSqrt2Pi = static_cast<float>(0.5 * std::log(2.0 * std::numbers::pi));
 
 using Net = PpoLearner::Net;
@@ -363,7 +362,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       return;
     }
     ContractFields f;
-    f.lag = kLags[derive_seed({o.seed, kPpoStream, 5, static_cast<std::uint64_t>(e), k}) % 4];
+    f.lag = kTrainingLags[derive_seed({o.seed, kPpoStream, 5, static_cast<std::uint64_t>(e), k}) % 4];
     lagged[ue].emplace(model, Contract::make(f));
     cur.col(e).head(env_obs_dim) = lagged[ue]->reset(seed).cast<float>();
     cur.col(e).tail(hist_dim).setZero();
@@ -424,15 +423,16 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
           step_success[ue] = success ? 1 : 0;
           step_end[ue] = (success || over) ? 1 : 0;
           step_boot[ue] = bootstraps(success, r.truncated, r.safety, o.bootstrap_success) ? 1 : 0;
-          // next network input: the observation, and (delay-aware) the history shifted by the executed action
-          Eigen::VectorXf next(obs_dim);
+          // next network input, built in this env's final_obs column (no allocation per step; the
+          // column is read only when the episode ended): the observation and, delay-aware, the
+          // history shifted by the executed action
+          auto next = final_obs.col(e);
           next.head(env_obs_dim) = r.obs.cast<float>();
           if (hist_dim > 0) {
+            next.segment(env_obs_dim + kActionDim, hist_dim - kActionDim) = cur.col(e).segment(env_obs_dim, hist_dim - kActionDim);
             next.segment(env_obs_dim, kActionDim) = a.cast<float>();
-            next.tail(hist_dim - kActionDim) = cur.col(e).segment(env_obs_dim, hist_dim - kActionDim);
           }
           if (step_end[ue]) {
-            final_obs.col(e) = next;
             step_return[ue] = o.delay_aware ? lagged[ue]->episode().episode_return : envs[ue]->episode().episode_return;
             reset_env(e);
           } else {
@@ -494,7 +494,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       } else {  // the episodes split over the training lags (contract index = the lag's slot)
         for (int li = 0; li < 4; ++li) {
           ContractFields f;
-          f.lag = kLags[li];
+          f.lag = kTrainingLags[li];
           ro.contract = Contract::make(f);
           ro.contract_index = static_cast<std::uint64_t>(li);
           ro.episodes = o.eval_episodes / 4 + (li < o.eval_episodes % 4 ? 1 : 0);

@@ -24,7 +24,6 @@ namespace actionshift::policy {
 namespace {
 
 constexpr std::uint64_t kTrainStream = 0x7472'6169'6e00'0000ULL;  // keeps training seeds apart from evaluation seeds
-constexpr int kLags[] = {0, 1, 2, 4};
 constexpr float kStdFloor = 1e-2f;
 
 // one collected episode: raw inputs (obs ++ history) and expert labels
@@ -157,7 +156,7 @@ TrainBcResult train_bc(const TrainBcOptions& o, const std::function<void(const T
           if (k >= o.episodes_per_iteration) break;
           Rng rng(derive_seed({o.seed, kTrainStream, static_cast<std::uint64_t>(it), static_cast<std::uint64_t>(k)}));
           const std::uint64_t env_seed = rng.next_u64();
-          const int lag = o.delay_aware ? kLags[rng.uniform_int(4)] : 0;
+          const int lag = o.delay_aware ? kTrainingLags[rng.uniform_int(4)] : 0;
           if (o.delay_aware) {
             ContractFields f;
             f.lag = lag;

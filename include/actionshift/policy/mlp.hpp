@@ -31,6 +31,9 @@ namespace actionshift::policy {
 
 /// Number of past canonical actions a delay-aware network sees (reference section 13: K = 4).
 inline constexpr int kHistoryLength = 4;
+/// Lags a delay-aware backbone is trained under, one drawn per episode (reference section 13), by
+/// `train bc --delay-aware` and `train ppo --delay-aware`.
+inline constexpr int kTrainingLags[] = {0, 1, 2, 4};
 
 /// Weights and normalisation of an MLP backbone (float32, as stored).
 struct MlpWeights {
