@@ -162,6 +162,24 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     p.bootstrap_success = !o.terminal_success;
     if (o.stop_after < 0) throw InputError("", "stop-after", "must be non-negative");
     p.stop_steps = o.stop_after;
+    if (!std::isfinite(o.init_log_std) || o.init_log_std < -5 || o.init_log_std > 1)
+      throw InputError("", "init-log-std", "must be in [-5, 1]");
+    p.init_log_std = o.init_log_std;
+    if (o.critic_warmup < 0) throw InputError("", "critic-warmup", "must be non-negative");
+    p.critic_warmup = o.critic_warmup;
+    std::string init_sha;
+    if (!o.init_from.empty()) {
+      const auto init = policy::MlpPolicy::from_file(o.init_from);
+      auto w = std::make_shared<const policy::MlpWeights>(init->weights());
+      if (w->task != p.task)
+        throw InputError(o.init_from, "task", "is " + std::string(sim::task_name(w->task)) + ", the run trains " + o.task);
+      const std::vector<int> hidden(w->layers.begin() + 1, w->layers.end() - 1);
+      if (hidden != p.hidden) throw InputError(o.init_from, "layers", "hidden widths differ from --hidden " + o.hidden);
+      if (w->history != 0 && !o.delay_aware)
+        throw InputError(o.init_from, "history", "a delay-aware network cannot start a reactive run (add --delay-aware)");
+      init_sha = init->sha256();
+      p.init_actor = std::move(w);
+    }
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
     const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
@@ -185,6 +203,9 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
       if (o.anneal_lr) cmd << " --anneal-lr";
       if (o.terminal_success) cmd << " --terminal-success";
       if (o.anneal_lr && steps < full_steps) cmd << " --stop-after " << steps;
+      if (!o.init_from.empty()) cmd << " --init-from " << o.init_from;
+      if (o.init_log_std != -0.5) cmd << " --init-log-std " << o.init_log_std;
+      if (o.critic_warmup > 0) cmd << " --critic-warmup " << o.critic_warmup;
       return cmd.str();
     };
     nlohmann::json provenance = {
@@ -208,6 +229,11 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
         {"init_log_std", p.init_log_std}};
     if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", policy::kTrainingLags}};
     if (o.anneal_lr) provenance["anneal_lr"] = true;
+    if (!o.init_from.empty()) {
+      provenance["init_from"] = {{"path", o.init_from}, {"sha256", init_sha}};
+      if (p.init_actor->training.contains("env_steps")) provenance["init_from"]["env_steps"] = p.init_actor->training["env_steps"];
+      provenance["critic_warmup"] = o.critic_warmup;
+    }
     provenance["success"] = o.terminal_success ? "terminal" : "bootstrapped with the critic's value of the final observation";
     const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;
     const std::int64_t iterations = std::max<std::int64_t>(1, o.total_steps / per_iter);

@@ -50,9 +50,12 @@ struct TrainPpoOptions {
   std::string curve;                // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
   std::string progress{"auto"};     // --progress auto|bar|lines|off
   bool delay_aware{false};          // --delay-aware (observation ++ last 4 actions, lags {0,1,2,4})
-  bool anneal_lr{false};
-  bool terminal_success{false};
-  std::int64_t stop_after{0};       // --stop-after STEPS (0: none)     // --terminal-success (value 0 after a success; earlier releases)            // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
+  bool anneal_lr{false};             // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
+  bool terminal_success{false};      // --terminal-success (value 0 after a success; earlier releases)
+  std::int64_t stop_after{0};        // --stop-after STEPS (0: none)
+  std::string init_from;             // --init-from FILE: warm-start the actor from a backbone file
+  double init_log_std{-0.5};         // --init-log-std
+  int critic_warmup{0};              // --critic-warmup ITERATIONS (actor frozen)
 };
 int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

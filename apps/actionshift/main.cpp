@@ -246,6 +246,12 @@ int main(int argc, char** argv) {
   ppo->add_flag("--terminal-success", ppo_o.terminal_success,
                 "Treat a success as terminal (value 0 after it) instead of bootstrapping it with the critic, as\n"
                 "ManiSkill's ppo.py does; the setting of earlier releases (rewards hovering short of the goal)");
+  ppo->add_option("--init-from", ppo_o.init_from,
+                  "Warm start (fine-tuning): the actor starts as this backbone file (same task and hidden widths; a\n"
+                  "reactive file may start a --delay-aware run, its history inputs weighted 0); the critic starts fresh");
+  ppo->add_option("--init-log-std", ppo_o.init_log_std, "Initial log standard deviation of the exploration noise")->capture_default_str();
+  ppo->add_option("--critic-warmup", ppo_o.critic_warmup,
+                  "Iterations at the start that train only the critic (actor frozen), for a warm start")->capture_default_str();
   ppo->add_option("--progress", ppo_o.progress, "auto, bar (one updating line), lines (one per iteration) or off")->capture_default_str();
   ppo->callback([&] { action = [&] { return cli::run_train_ppo(ppo_o); }; });
   cli::Gate0Options gate0_o;

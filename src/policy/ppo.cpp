@@ -174,6 +174,26 @@ PpoLearner::PpoLearner(const PpoOptions& options, int obs_dim) : o_(options) {
   actor_ = make_net(sizes_of(obs_dim, o_.hidden, kActionDim), 0.01 * std::sqrt(2.0), rng);
   critic_ = make_net(sizes_of(obs_dim, o_.hidden, 1), 1.0, rng);
   log_std_ = Eigen::VectorXf::Constant(kActionDim, static_cast<float>(o_.init_log_std));
+  if (o_.init_actor) {
+    const MlpWeights& w = *o_.init_actor;
+    const std::vector<int> want = sizes_of(w.input_dim(), o_.hidden, kActionDim);
+    if (w.task != o_.task || w.layers != want || w.w.size() != actor_.w.size())
+      throw std::invalid_argument("PPO warm start: the initial actor's task or hidden widths differ from the run's");
+    const int in = w.input_dim();
+    if (in != obs_dim && !(w.history == 0 && o_.delay_aware && in == obs_dim - kHistoryLength * kActionDim))
+      throw std::invalid_argument("PPO warm start: the initial actor's input (" + std::to_string(in) + ") does not fit the run's (" +
+                                  std::to_string(obs_dim) + ")");
+    for (std::size_t i = 0; i < actor_.w.size(); ++i) {
+      actor_.w[i] = w.w[i];
+      actor_.b[i] = w.b[i];
+    }
+    // fold x_norm = (x - mean) / std into the first layer; zero weights on inputs the actor lacked
+    const Eigen::VectorXf inv_std = w.input_std.cwiseInverse();
+    Eigen::MatrixXf w0 = Eigen::MatrixXf::Zero(w.w[0].rows(), obs_dim);
+    w0.leftCols(in) = w.w[0] * inv_std.asDiagonal();
+    actor_.b[0] = w.b[0] - w0.leftCols(in) * w.input_mean;
+    actor_.w[0] = w0;
+  }
   m_actor_ = zeros_like(actor_);
   v_actor_ = zeros_like(actor_);
   m_critic_ = zeros_like(critic_);
@@ -280,21 +300,27 @@ PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_s
         total.approx_kl += g.approx_kl;
         total.clipped += g.clipped;
       }
-      // global gradient-norm clipping over every parameter, then Adam
-      const double norm = std::sqrt(squared_norm(total.actor) + squared_norm(total.critic) + total.log_std.squaredNorm());
+      // global gradient-norm clipping over every parameter that learns, then Adam
+      const double norm = std::sqrt((actor_frozen_ ? 0.0 : squared_norm(total.actor) + total.log_std.squaredNorm()) +
+                                    squared_norm(total.critic));
       if (o_.max_grad_norm > 0 && norm > o_.max_grad_norm) {
         const float f = static_cast<float>(o_.max_grad_norm / (norm + 1e-6));
         scale(total.actor, f);
         scale(total.critic, f);
         total.log_std *= f;
       }
-      ++adam_t_;
-      const float c1 = 1.0f - std::pow(0.9f, static_cast<float>(adam_t_));
-      const float c2 = 1.0f - std::pow(0.999f, static_cast<float>(adam_t_));
+      // Adam step counts per group: a critic warm-up does not advance the frozen actor's bias correction
       const float lr = static_cast<float>(o_.learning_rate), eps = static_cast<float>(o_.adam_eps);
-      adam_net(actor_, m_actor_, v_actor_, total.actor, lr, c1, c2, eps);
+      auto corr = [](int t, float beta) { return 1.0f - std::pow(beta, static_cast<float>(t)); };
+      if (!actor_frozen_) {
+        ++adam_t_actor_;
+        const float a1 = corr(adam_t_actor_, 0.9f), a2 = corr(adam_t_actor_, 0.999f);
+        adam_net(actor_, m_actor_, v_actor_, total.actor, lr, a1, a2, eps);
+        adam(log_std_, m_log_std_, v_log_std_, total.log_std, lr, a1, a2, eps);
+      }
+      ++adam_t_;
+      const float c1 = corr(adam_t_, 0.9f), c2 = corr(adam_t_, 0.999f);
       adam_net(critic_, m_critic_, v_critic_, total.critic, lr, c1, c2, eps);
-      adam(log_std_, m_log_std_, v_log_std_, total.log_std, lr, c1, c2, eps);
       pl += total.policy_loss;
       vl += total.value_loss;
       kl = total.approx_kl * inv_m;  // the last minibatch's, as the baseline's early stop
@@ -329,7 +355,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
                     const std::function<void(const MlpWeights&)>& checkpoint) {
   if (o.num_envs <= 0 || o.num_steps <= 0 || o.total_steps <= 0 || o.num_minibatches <= 0 || o.update_epochs <= 0 ||
       o.hidden.empty() || !(o.learning_rate > 0) || o.eval_episodes < 0 || o.eval_every < 0 ||
-      static_cast<std::int64_t>(o.num_envs) * o.num_steps < o.num_minibatches)
+      static_cast<std::int64_t>(o.num_envs) * o.num_steps < o.num_minibatches || o.critic_warmup < 0)
     throw std::invalid_argument("train_ppo: envs, steps, minibatches, epochs, hidden layers and learning rate must be positive");
   for (int h : o.hidden)
     if (h <= 0 || h > 4096) throw std::invalid_argument("train_ppo: hidden layer widths must be in [1, 4096]");
@@ -462,6 +488,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       }
     }
     env_steps += per_iter;
+    learner.set_actor_frozen(it < o.critic_warmup);
     if (o.anneal_lr)  // ManiSkill ppo.py: lr * (1 - iteration / iterations), set before each update
       learner.set_learning_rate(o.learning_rate * (1.0 - static_cast<double>(it) / static_cast<double>(iterations)));
     batch.advantages = gae(rewards, values, final_values, ended, learner.value(cur), n_env, o.gamma, o.gae_lambda);

@@ -121,20 +121,29 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
   std::map<std::string, std::string> listed;
   for (std::string sha, file; sums >> sha >> file;) listed[file] = sha;
   int files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(ACTIONSHIFT_SOURCE_DIR "/configs/backbones")) {
+  // the backbones themselves, and under stages/ the files a committed backbone was warm-started from
+  // (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs)
+  const std::filesystem::path root = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
     const std::string name = entry.path().filename().string();
     if (!name.ends_with(".asmlp")) continue;
     ++files;
+    const std::string rel = std::filesystem::relative(entry.path(), root).generic_string();
     std::ifstream f(entry.path(), std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    EXPECT_EQ(listed[name], sha256_hex(bytes)) << name << " vs SHA256SUMS";
-    // <task>.<backbone>.asmlp loads through the registry as that backbone, for that task
+    EXPECT_EQ(listed[rel], sha256_hex(bytes)) << rel << " vs SHA256SUMS";
     const std::string stem = name.substr(0, name.size() - 6);
     const auto dot = stem.find('.');
     ASSERT_NE(dot, std::string::npos) << name;
     const sim::TaskId task = sim::parse_task(stem.substr(0, dot));
+    if (rel != name) {  // a stage: loads as a weight file of its task
+      ASSERT_EQ(rel.rfind("stages/", 0), 0u) << rel;
+      EXPECT_EQ(policy::MlpPolicy::from_file(entry.path().string())->task(), task) << rel;
+      continue;
+    }
+    // <task>.<backbone>.asmlp loads through the registry as that backbone, for that task
     policy::RegistryOptions ro;
-    ro.backbones_dir = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
+    ro.backbones_dir = root.string();
     auto p = policy::make_policy(stem.substr(dot + 1), task, ro);
     EXPECT_EQ(p->task(), task) << name;
     EXPECT_EQ(p->sha256(), sha256_hex(bytes)) << name;

@@ -173,6 +173,64 @@ TEST(PpoTrain, SuccessIsBootstrappedAsManiSkillDoesUnlessTerminalIsAsked) {
   EXPECT_FALSE(policy::bootstraps(true, false, SafetyFlag::kWorkspaceViolation, true));
 }
 
+TEST(PpoWarmStart, ActorStartsAsTheInitialBackboneWithItsNormalisationFoldedAndZeroHistoryWeights) {
+  // a reactive push network with a non-identity input normalisation
+  auto init = std::make_shared<policy::MlpWeights>(policy::MlpWeights::init(sim::TaskId::kPushCube, 0, {16, 16}, 5));
+  for (int i = 0; i < init->input_dim(); ++i) {
+    init->input_mean(i) = 0.1f * static_cast<float>(i % 5) - 0.2f;
+    init->input_std(i) = 0.5f + 0.05f * static_cast<float>(i % 7);
+  }
+  for (auto& b : init->b) b.setConstant(0.03f);
+  policy::PpoOptions o = tiny(1);
+  o.init_actor = init;
+  o.delay_aware = true;
+  const int in = init->input_dim(), dim = in + 7 * policy::kHistoryLength;
+  policy::PpoLearner learner(o, dim);
+  Eigen::MatrixXf x = Eigen::MatrixXf::Random(dim, 3) * 0.3f;
+  const Eigen::MatrixXf m = learner.mean(x);
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::VectorXf obs = x.col(c).head(in);
+    // mlp_forward clips to [-1, 1]; compare where the raw mean is inside
+    const Action want = policy::mlp_forward(*init, obs);
+    for (int j = 0; j < 7; ++j)
+      if (std::abs(m(j, c)) < 0.99f) {
+        EXPECT_NEAR(m(j, c), want(j), 1e-5) << "column " << c << " channel " << j;
+      }
+  }
+  // the history inputs do not move the warm-started actor
+  Eigen::MatrixXf y = x;
+  y.bottomRows(7 * policy::kHistoryLength).setConstant(0.7f);
+  EXPECT_TRUE(learner.mean(y).isApprox(m, 1e-6f));
+  // a fresh learner differs; a wrong width or task is refused
+  EXPECT_FALSE(policy::PpoLearner(tiny(1), in).mean(x.topRows(in)).isApprox(m, 1e-3f));
+  auto bad = tiny(1);
+  bad.init_actor = init;
+  bad.hidden = {16, 8};
+  EXPECT_THROW(policy::PpoLearner(bad, in), std::invalid_argument);
+  bad = tiny(1);
+  bad.init_actor = init;
+  bad.task = sim::TaskId::kPullCube;
+  EXPECT_THROW(policy::PpoLearner(bad, in), std::invalid_argument);
+}
+
+TEST(PpoWarmStart, CriticWarmupFreezesTheActorThenReleasesIt) {
+  auto first = policy::train_ppo(tiny(1), {});
+  auto init = std::make_shared<const policy::MlpWeights>(first.actor);
+  auto o = tiny(1);
+  o.init_actor = init;
+  o.critic_warmup = 2;  // the whole (2-iteration) run
+  o.eval_episodes = 0;
+  const auto frozen = policy::train_ppo(o, {});
+  EXPECT_EQ(frozen.actor.w, init->w);
+  EXPECT_EQ(frozen.actor.b, init->b);
+  o.critic_warmup = 1;  // the second iteration moves it
+  const auto moved = policy::train_ppo(o, {});
+  EXPECT_NE(moved.actor.w, init->w);
+  // deterministic whatever the threads
+  o.threads = 2;
+  EXPECT_EQ(policy::serialize_mlp(policy::train_ppo(o, {}).actor), policy::serialize_mlp(moved.actor));
+}
+
 TEST(PpoTrain, RejectsNonPositiveSizes) {
   auto o = tiny(1);
   o.num_envs = 0;

@@ -29,6 +29,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,15 @@ struct PpoOptions {
   /// total_steps). The learning-rate schedule still spans total_steps, so an annealed run's checkpoint
   /// is reproduced by the same total_steps plus stop_steps = its step count.
   std::int64_t stop_steps{0};
+  /// Warm start (fine-tuning): the actor mean network starts as this backbone instead of a random one
+  /// (its input normalisation folded into the first layer; a reactive network's weights on the
+  /// delay-aware history inputs start at 0, so the delay-aware actor starts as exactly the reactive
+  /// one). Its hidden widths must equal `hidden`, its task `task`. The critic and log std start fresh
+  /// (init_log_std); nullptr: a fresh actor.
+  std::shared_ptr<const MlpWeights> init_actor;
+  /// Iterations at the start of the run that update only the critic (the actor and log std frozen),
+  /// so a warm-started actor is not pushed around by a fresh critic's advantages.
+  int critic_warmup{0};
 };
 
 /// One training iteration (rollout + update).
@@ -145,6 +155,8 @@ class PpoLearner {
   PpoUpdateStats update(const PpoBatch& batch, std::uint64_t shuffle_seed, unsigned threads);
   /// Set the Adam learning rate of the following updates (learning-rate annealing).
   void set_learning_rate(double lr) { o_.learning_rate = lr; }
+  /// Freeze the actor and log std in the following updates (only the critic learns).
+  void set_actor_frozen(bool frozen) { actor_frozen_ = frozen; }
 
   /// The actor mean network as a backbone (identity normalisation; `training` = provenance).
   MlpWeights actor_weights(sim::TaskId task, const nlohmann::json& training) const;
@@ -162,7 +174,9 @@ class PpoLearner {
   // Adam moments, same shapes as the parameters; step count
   Net m_actor_, v_actor_, m_critic_, v_critic_;
   Eigen::VectorXf m_log_std_, v_log_std_;
-  int adam_t_{0};
+  int adam_t_{0};        // critic
+  int adam_t_actor_{0};  // actor and log std
+  bool actor_frozen_{false};
 };
 
 /// Train with PPO. `progress` (optional) is called after every iteration; `checkpoint` (optional)
