@@ -341,6 +341,9 @@ def main():
         print(f"   verify vs actionshift.evaluate(): evaluate {v['evaluate_rate']:.3f}, loop {v['loop_rate']:.3f}, "
               f"success flags equal {v['flags_equal']}/{v['episodes']}, step counts equal {v['steps_equal']}/{v['episodes']} "
               f"({time.time() - t1:.1f} s)")
+    if v is not None and (v["flags_equal"] != v["episodes"] or v["steps_equal"] != v["episodes"]):
+        print("belief_trace: the Python loop disagrees with actionshift.evaluate()", file=sys.stderr)
+        sys.exit(1)
     if args.json:
         row = dict(task=args.task, backbone=args.backbone, history=args.history, perturb=args.perturb, perturb_part=args.perturb_part, method=args.method, pool=pool,
                    split=args.split, seed=args.seed, summary=s,
