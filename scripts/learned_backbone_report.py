@@ -91,11 +91,12 @@ else:
     print("backbone that passes Gate 0 on the tasks (the DAgger-trained MLP, docs/backbones.md) and sets it beside the")
     print("expert's cells of the same experiments (the PPO backbones have their own page, docs/results/learned_backbone_ppo.md).")
     print("stack_cube is left out: its MLP is excluded at Gate 0.\n")
-print(f"- Command: `{'LEARNED=' + LEARNED + ' ' if LEARNED != 'mlp' else ''}scripts/learned_backbone {out} {expert_gate1} {expert_tournament}`;"
+THREADS = os.environ.get("THREADS", "0")
+print(f"- Command: `{'THREADS=' + THREADS + ' ' if THREADS != '0' else ''}{'LEARNED=' + LEARNED + ' ' if LEARNED != 'mlp' else ''}scripts/learned_backbone {out} {expert_gate1} {expert_tournament}`;"
       f" experiments `configs/experiments/gate1_{LEARNED}.yaml`"
       f" and `configs/experiments/tournament_{LEARNED}.yaml` (the expert cells come from `gate1.yaml` and `tournament.yaml`);"
       f" {len({j for c in list(g_mlp.values()) + list(t_mlp.values()) for j in c['jobs']})} learned-backbone jobs, {episodes:,} episodes;"
-      f" wall time {int(float(wall))} s on {os.cpu_count()} cores{cpu}.")
+      f" wall time {int(float(wall))} s on {os.cpu_count()} cores" + (f" (`run --threads {THREADS}`)" if THREADS != "0" else "") + f"{cpu}.")
 per_job = lambda d, cs: "/".join(str(e) for e in sorted({s["episodes"] for s in specs(d, cs)}))
 print(f"- Simulator profile **{', '.join(profiles)}**; seeds {', '.join(map(str, seeds))}; Gate 1: {per_job(g_mlp_dir, g_mlp)} episodes"
       f" per job on the generated splits (32 contracts each); tournament: {per_job(t_mlp_dir, t_mlp)} episodes per job (half per"
