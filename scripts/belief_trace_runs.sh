@@ -1,14 +1,24 @@
 #!/usr/bin/env bash
-# The runs behind docs/results/belief_trace.md (diagnostic; see scripts/belief_trace.py).
-# Usage: PYTHONPATH=/work/main/build/python bash scripts/belief_trace_runs.sh OUT.jsonl [CLI_OUT_DIR]
-# Appends one summary line per cell to OUT.jsonl; with CLI_OUT_DIR it also runs the C++ backbones
-# through `actionshift run` (one thread) for the numpy-vs-C++ comparison of the main cells.
+# The runs behind docs/results/belief_trace.md (diagnostic; see scripts/belief_trace.py), and the page.
+# Usage: bash scripts/belief_trace_runs.sh OUT.jsonl [CLI_OUT_DIR]
+# Writes one summary line per cell to OUT.jsonl (emptied first: the page is generated from this file and
+# must describe one run of this script), then regenerates docs/results/belief_trace.md from it with
+# scripts/belief_trace_report.py. With CLI_OUT_DIR it also runs the C++ backbones through
+# `actionshift run` (one thread) for the numpy-vs-C++ comparison of the main cells (step 5), and the
+# page gets those columns.
+# Environment (all optional): ACTIONSHIFT_BUILD_DIR (default build, relative to the source tree) for
+# PYTHONPATH (<build>/python, unless PYTHONPATH is set) and the CLI (<build>/apps/actionshift/actionshift,
+# or AS); ACTIONSHIFT_BACKBONES_DIR (default configs/backbones of this tree).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 J=${1:?OUT.jsonl}
 CLI_OUT=${2:-}
-AS=${AS:-/work/main/build/apps/actionshift/actionshift}
+BUILD=${ACTIONSHIFT_BUILD_DIR:-build}
+AS=${AS:-$BUILD/apps/actionshift/actionshift}
+export PYTHONPATH=${PYTHONPATH:-$BUILD/python}
+export ACTIONSHIFT_BACKBONES_DIR=${ACTIONSHIFT_BACKBONES_DIR:-$PWD/configs/backbones}
 P="nice -n 10 python3 scripts/belief_trace.py --task push_cube --episodes 100"
+: > "$J"
 
 # 1. the main cells, each verified against actionshift.evaluate() (seed 20260718)
 for bb in ppo ppo-delay-aware; do
@@ -70,3 +80,7 @@ if [ -n "$CLI_OUT" ]; then
     done
   done
 fi
+# 6. the page, generated from the summaries (and the C++ records when CLI_OUT_DIR was given)
+python3 scripts/belief_trace_report.py "$J" --commit "$(git rev-parse --short HEAD)" ${CLI_OUT:+--cli-dir "$CLI_OUT"} \
+  > docs/results/belief_trace.md.tmp
+mv docs/results/belief_trace.md.tmp docs/results/belief_trace.md
