@@ -32,7 +32,7 @@ History modes for the delay-aware network (--history):
 sends while its MAP is the pool's first hypothesis, the identity), the oracle's encoding after;
 --perturb-part pose|gripper: only those channels sent unencoded, the others encoded right.
 
-Usage (PYTHONPATH must reach the built module, e.g. /work/main/build/python):
+Usage (PYTHONPATH must reach the built module, e.g. build/python from the repository root):
   python3 scripts/belief_trace.py --backbone ppo-delay-aware --method exact_belief \
       --split reference_seen --pool reference9 --episodes 100 [--verify] [--json out.json]
 """
@@ -50,7 +50,8 @@ import numpy as np
 import actionshift
 
 M64 = (1 << 64) - 1
-BACKBONES_DIR = os.environ.get("ACTIONSHIFT_BACKBONES_DIR", "/work/main/configs/backbones")
+BACKBONES_DIR = os.environ.get("ACTIONSHIFT_BACKBONES_DIR",
+                               os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "configs", "backbones"))
 
 
 # ------------------------------------------------------------------ seeds (src/eval/job.cpp)
