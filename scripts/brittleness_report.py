@@ -76,7 +76,7 @@ print("environment), behind the hidden contracts with no adaptation, and through
 print("parameters (docs/adapters.md): the privileged oracle, entropy probing and DualABI over the `reference9` pool, and")
 print("the pool-free grammar belief. The imitation backbone is the project's DAgger MLP (the paper's is a Diffusion")
 print("Policy); the RL backbone is `train ppo`'s actor, where one is committed (docs/backbones.md).\n")
-print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} nice -n 10 scripts/brittleness {results}`; {len(specs)} jobs + the clean Gate 0 runs;"
+print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} scripts/brittleness {results}`; {len(specs)} jobs + the clean Gate 0 runs;"
       f" wall time {WALL_TEXT} on {threads} thread(s) of a shared {os.cpu_count()}-core machine (load average {os.getloadavg()[1]:.1f} over the last 5 minutes at the end){cpu_text(CPU)}.")
 print(f"- Simulator profile **{', '.join(profiles)}**; split `reference_seen` (the paper's two seen contracts); seeds"
       f" {', '.join(map(str, seeds))}; {', '.join(map(str, eps))} episodes per job (half per contract), so"

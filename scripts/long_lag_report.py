@@ -106,7 +106,7 @@ print("its input, DAgger-trained under a lag drawn from {0, 1, 2, 4}) and `ppo-d
 print("the paper's own recipe, an augmented-state PPO with observation + last four executed canonical actions, trained")
 print("under a lag drawn from {0, 1, 2, 4}). Their reactive counterparts are `expert`, `mlp` and `ppo`. The paper's")
 print("'frozen ref' column is its reactive PPO, so the `ppo` rows are the like-for-like comparison.\n")
-print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} nice -n 10 scripts/long_lag {results}`; {len(specs)} jobs, {total:,} episodes;"
+print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} scripts/long_lag {results}`; {len(specs)} jobs, {total:,} episodes;"
       f" wall time {int(float(wall))} s on {threads} thread(s) of a shared {os.cpu_count()}-core machine (load average {os.getloadavg()[1]:.1f} over the last 5 minutes at the end){cpu_text(CPU)}.")
 print(f"- Simulator profile **{', '.join(profiles)}** (docs/sim.md); seeds {', '.join(map(str, seeds))};"
       f" {', '.join(map(str, eps))} episodes per (task, split, backbone, method, seed), dealt round-robin over the split's contracts.")
