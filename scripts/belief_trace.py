@@ -80,6 +80,8 @@ def load_asmlp(path):
     version, hlen = struct.unpack("<II", b[8:16])
     if version != 1:
         raise ValueError(f"{path}: version {version}")
+    if len(b) < 16 + hlen:
+        raise ValueError(f"{path}: header: truncated: {len(b)} bytes, header length {hlen}")
     header = json.loads(b[16:16 + hlen].decode("utf-8"))
     payload = np.frombuffer(b[16 + hlen:], dtype="<f4")
     if payload.size != header["payload_floats"]:
@@ -355,4 +357,8 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except (OSError, ValueError, KeyError, actionshift.InputError) as e:  # bad file, name or manifest: one line, exit 2
+        print(f"belief_trace: {e}", file=sys.stderr)
+        sys.exit(2)

@@ -4,6 +4,8 @@ policy, and its per-step "the belief is right" flag is right at every step under
 at step 0 under the exact belief on a contract the identity does not match."""
 import importlib.util
 import os
+import subprocess
+import sys
 
 SRC = os.environ.get("ACTIONSHIFT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 spec = importlib.util.spec_from_file_location("belief_trace", os.path.join(SRC, "scripts", "belief_trace.py"))
@@ -24,3 +26,14 @@ def test_right_flag_under_the_oracle_and_the_exact_belief():
     exact = bt.run_cell("push_cube", "ppo", "exact_belief", "reference_seen", "reference9", 20260718, 3)
     # the belief starts on the pool's first hypothesis; a non-identity contract is mis-encoded at step 0
     assert any(not e["right"][0] for e in exact)
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path):
+    good = os.path.join(SRC, "configs", "backbones", "push_cube.ppo.asmlp")
+    truncated = tmp_path / "t.asmlp"
+    truncated.write_bytes(open(good, "rb").read()[:100])
+    for args in (["--backbone", str(truncated)], ["--split", "no_such_split"], ["--backbone", str(tmp_path / "missing.asmlp")]):
+        r = subprocess.run([sys.executable, os.path.join(SRC, "scripts", "belief_trace.py"), "--episodes", "1", *args],
+                           capture_output=True, text=True)
+        assert r.returncode == 2, (args, r.stderr)
+        assert len(r.stderr.strip().splitlines()) == 1 and r.stderr.startswith("belief_trace: "), r.stderr
