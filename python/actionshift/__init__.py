@@ -217,7 +217,7 @@ def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None):
 
 def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,
              out="results", backbone=None, pool=None, params=None, rotation="live", profile="maniskill",
-             progress="off"):
+             progress="off", threads=1):
     """Run ``policy`` (a callable obs -> 7 canonical numbers; its ``reset()`` is called at each
     episode start if it has one) as the backbone of one hash-addressed job, in this process,
     through the library's runner: ``<out>/<job id>.jsonl`` and ``.summary.json``, exactly as
@@ -227,12 +227,18 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     backbone: the backbone's name in the job. ``"external:<command>"`` gives the job (id and JSONL)
     that ``actionshift run --backbone "external:<command>"`` writes when that command serves the same
     policy (e.g. through ``serve_policy``); default ``"python:<module>.<name>"`` of the callable.
+
+    threads: episodes run on this many worker threads (0: all cores); the records and the job are
+    the same for any count. With 1 (the default) ``policy`` itself is called; with more, each worker
+    calls its own ``copy.deepcopy(policy)`` (as ``actionshift run --threads N`` starts one external
+    process per worker), the simulation runs in parallel and only the policy calls take turns on the
+    GIL. A plain function is not copied by ``deepcopy``: it must not keep state between calls.
     """
     if backbone is None:
         target = policy if hasattr(policy, "__qualname__") else type(policy)
         backbone = f"python:{getattr(target, '__module__', '?')}.{target.__qualname__}"
     return _native._evaluate(policy, task, split, method, int(seed), int(episodes), str(out), backbone, pool,
-                             params, rotation, profile, progress)
+                             params, rotation, profile, progress, int(threads))
 
 
 def serve_policy(policy, stdin=None, stdout=None):

@@ -515,8 +515,11 @@ double bench_cpp_steps(const std::string& task, const DArray& actions, std::uint
 // method if it has one. Every clone shares the one Python object, so run it with one thread.
 class PythonPolicy final : public policy::Policy {
  public:
-  PythonPolicy(py::object fn, std::string name, std::string sha256, sim::TaskId task)
-      : fn_(std::make_shared<py::object>(std::move(fn))), name_(std::move(name)), sha_(std::move(sha256)), task_(task) {}
+  // copy_per_worker: every clone() is a copy.deepcopy of the callable (one per runner worker, as the
+  // external-process backbone starts one process per worker); otherwise clones share the callable
+  PythonPolicy(py::object fn, std::string name, std::string sha256, sim::TaskId task, bool copy_per_worker = false)
+      : fn_(std::make_shared<py::object>(std::move(fn))), name_(std::move(name)), sha_(std::move(sha256)), task_(task),
+        copy_(copy_per_worker) {}
   ~PythonPolicy() override {
     py::gil_scoped_acquire gil;
     fn_.reset();
@@ -537,13 +540,15 @@ class PythonPolicy final : public policy::Policy {
   sim::TaskId task() const override { return task_; }
   std::unique_ptr<policy::Policy> clone() const override {
     py::gil_scoped_acquire gil;
-    return std::make_unique<PythonPolicy>(*fn_, name_, sha_, task_);
+    if (!copy_) return std::make_unique<PythonPolicy>(*fn_, name_, sha_, task_);
+    return std::make_unique<PythonPolicy>(py::module_::import("copy").attr("deepcopy")(*fn_), name_, sha_, task_);
   }
 
  private:
   std::shared_ptr<py::object> fn_;
   std::string name_, sha_;
   sim::TaskId task_;
+  bool copy_{false};
 };
 
 // backbone identity of a Python policy: "external:<command>" hashes the command exactly as the
@@ -563,8 +568,9 @@ eval::BackboneRef backbone_ref(const std::string& name) {
 py::dict evaluate(py::object policy, const std::string& task, const std::string& split, const std::string& method,
                   std::uint64_t seed, std::int64_t episodes, const std::string& out, const std::string& backbone,
                   std::optional<std::string> pool, py::object params, const std::string& rotation,
-                  const std::string& profile, const std::string& progress) {
+                  const std::string& profile, const std::string& progress, int threads) {
   if (!PyCallable_Check(policy.ptr())) throw py::type_error("policy: must be callable (obs -> 7 numbers)");
+  if (threads < 0) throw InputError("evaluate", "threads", "must be 0 (all cores) or a positive count (got " + std::to_string(threads) + ")");
   env_config_for_profile(profile);  // validates the name
   eval::JobRequest q;
   q.profile = profile;
@@ -580,9 +586,23 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   eval::PlanResolver resolver = eval::default_resolver();
   resolver.backbone = [](const std::string&, const std::string& name) { return backbone_ref(name); };
   const eval::JobSpec job = eval::resolve_job(q, resolver);
-  auto prototype = std::make_shared<PythonPolicy>(policy, job.backbone.name, job.backbone.sha256, sim::parse_task(task));
+  // threads > 1: the physics of the episodes runs in parallel without the GIL; each worker calls its
+  // own copy.deepcopy of the policy (a stateful policy must not see two episodes at once). Checked
+  // here, so a policy that cannot be copied fails before any episode runs
+  const unsigned workers = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : static_cast<unsigned>(threads);
+  if (workers > 1) {
+    try {
+      py::module_::import("copy").attr("deepcopy")(policy);
+    } catch (py::error_already_set& e) {
+      throw InputError("evaluate", "threads",
+                       "each of the " + std::to_string(workers) + " workers needs copy.deepcopy(policy), which failed (" +
+                           std::string(e.what()).substr(0, std::string(e.what()).find('\n')) + "); use threads=1");
+    }
+  }
+  auto prototype =
+      std::make_shared<PythonPolicy>(policy, job.backbone.name, job.backbone.sha256, sim::parse_task(task), workers > 1);
   eval::RunOptions ro;
-  ro.threads = 1;  // one Python callable: its calls are serialised by the GIL anyway
+  ro.threads = workers;
   ro.out_dir = out;
   if (progress == "off") ro.progress = eval::ProgressMode::off;
   else if (progress == "lines") ro.progress = eval::ProgressMode::lines;
@@ -955,7 +975,7 @@ PYBIND11_MODULE(_native, m) {
   // ---- evaluation
   m.def("_evaluate", &evaluate, py::arg("policy"), py::arg("task"), py::arg("split"), py::arg("method"), py::arg("seed"),
         py::arg("episodes"), py::arg("out"), py::arg("backbone"), py::arg("pool"), py::arg("params"),
-        py::arg("rotation"), py::arg("profile"), py::arg("progress"));
+        py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"));
   m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec)), "job")); },
         py::arg("job"));
 

@@ -57,28 +57,32 @@ def bench_steps(task, steps, runs):
 
 
 def bench_evaluate(cli, episodes, runs, threads):
-    inproc, external = [], []
+    """Median seconds of one job, in process and through the external process, at each thread count
+    (in process: evaluate(threads=T); external: `actionshift run --threads T`, one process per worker)."""
+    inproc = {t: [] for t in threads}
+    external = {t: [] for t in threads}
     with tempfile.TemporaryDirectory() as tmp:
         server = os.path.join(tmp, "zero_server.py")
         with open(server, "w") as f:
             f.write(TRIVIAL_SERVER)
         backbone = f"external:{sys.executable} {server}"
         for k in range(runs):
-            out = os.path.join(tmp, f"inproc{k}")
-            t0 = time.perf_counter()
-            r = actionshift.evaluate(zero_policy, task="pick_cube", split="seen", method="no_adapt", seed=k,
-                                     episodes=episodes, out=out, backbone=backbone)
-            inproc.append(time.perf_counter() - t0)
-            out2 = os.path.join(tmp, f"external{k}")
-            t0 = time.perf_counter()
-            subprocess.run([cli, "run", "--task", "pick_cube", "--split", "seen", "--method", "no_adapt",
-                            "--seed", str(k), "--episodes", str(episodes), "--backbone", backbone, "--out", out2,
-                            "--progress", "off", "--threads", str(threads)], check=True, capture_output=True)
-            external.append(time.perf_counter() - t0)
-            a = open(os.path.join(out, r["job_id"] + ".jsonl"), "rb").read()
-            b = open(os.path.join(out2, r["job_id"] + ".jsonl"), "rb").read()
-            assert a == b, "in-process and external JSONL differ"
-    return statistics.median(inproc), statistics.median(external), inproc, external
+            for t in threads:
+                out = os.path.join(tmp, f"inproc{k}_{t}")
+                t0 = time.perf_counter()
+                r = actionshift.evaluate(zero_policy, task="pick_cube", split="seen", method="no_adapt", seed=k,
+                                         episodes=episodes, out=out, backbone=backbone, threads=t)
+                inproc[t].append(time.perf_counter() - t0)
+                out2 = os.path.join(tmp, f"external{k}_{t}")
+                t0 = time.perf_counter()
+                subprocess.run([cli, "run", "--task", "pick_cube", "--split", "seen", "--method", "no_adapt",
+                                "--seed", str(k), "--episodes", str(episodes), "--backbone", backbone, "--out", out2,
+                                "--progress", "off", "--threads", str(t)], check=True, capture_output=True)
+                external[t].append(time.perf_counter() - t0)
+                a = open(os.path.join(out, r["job_id"] + ".jsonl"), "rb").read()
+                b = open(os.path.join(out2, r["job_id"] + ".jsonl"), "rb").read()
+                assert a == b, "in-process and external JSONL differ"
+    return inproc, external
 
 
 def main():
@@ -88,27 +92,36 @@ def main():
     ap.add_argument("--steps", type=int, default=2000, help="control steps per step-cost run")
     ap.add_argument("--episodes", type=int, default=32, help="episodes per evaluation run")
     ap.add_argument("--runs", type=int, default=5, help="runs per figure (medians)")
-    ap.add_argument("--threads", type=int, default=1, help="--threads of the CLI run (in process: 1)")
+    ap.add_argument("--threads", default="1,2",
+                    help="comma-separated thread counts of both sides (evaluate(threads=T), run --threads T)")
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     a = ap.parse_args()
     cpp, py, cpp_runs, py_runs = bench_steps(a.task, a.steps, a.runs)
-    ev_in, ev_ext, in_runs, ext_runs = bench_evaluate(a.cli, a.episodes, a.runs, a.threads)
+    threads = [int(t) for t in a.threads.split(",")]
+    inproc, external = bench_evaluate(a.cli, a.episodes, a.runs, threads)
+    med = statistics.median
     result = {
         "task": a.task, "steps": a.steps, "runs": a.runs,
         "cpp_us_per_step": cpp * 1e6, "python_us_per_step": py * 1e6, "python_overhead_pct": (py / cpp - 1) * 100,
         "cpp_runs_us": [x * 1e6 for x in cpp_runs], "python_runs_us": [x * 1e6 for x in py_runs],
-        "episodes": a.episodes, "cli_threads": a.threads,
-        "evaluate_in_process_s": ev_in, "evaluate_external_s": ev_ext, "speedup": ev_ext / ev_in,
-        "in_process_runs_s": in_runs, "external_runs_s": ext_runs,
+        "episodes": a.episodes,
+        "evaluate": [{"threads": t, "in_process_s": med(inproc[t]), "external_s": med(external[t]),
+                      "speedup": med(external[t]) / med(inproc[t]),
+                      "in_process_runs_s": inproc[t], "external_runs_s": external[t]} for t in threads],
     }
     if a.json:
         print(json.dumps(result, indent=2))
         return
     print(f"per control step ({a.task}, {a.steps} steps, median of {a.runs}): C++ {cpp * 1e6:.1f} us, "
           f"Python {py * 1e6:.1f} us, overhead {result['python_overhead_pct']:+.1f} %")
-    print(f"evaluate ({a.episodes} episodes of a trivial policy, median of {a.runs}): in process {ev_in:.2f} s, "
-          f"external process (--threads {a.threads}) {ev_ext:.2f} s, speed-up {result['speedup']:.1f}x")
-
+    for e in result["evaluate"]:
+        print(f"evaluate ({a.episodes} episodes of a trivial policy, {e['threads']} thread(s), median of {a.runs}): "
+              f"in process {e['in_process_s']:.3f} s, external process {e['external_s']:.3f} s, "
+              f"speed-up {e['speedup']:.1f}x")
+    t1 = result["evaluate"][0]
+    for e in result["evaluate"][1:]:
+        print(f"in process on {e['threads']} threads vs external process on {t1['threads']}: "
+              f"{t1['external_s'] / e['in_process_s']:.1f}x")
 
 if __name__ == "__main__":
     main()

@@ -65,3 +65,36 @@ def test_evaluate_errors(tmp_path, cli):
         actionshift.evaluate("not callable", episodes=1, out=str(tmp_path))
     with pytest.raises(ValueError, match="profile"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), profile="no_such_profile")
+
+
+def test_threads_give_the_same_job_and_copy_the_policy_per_worker(tmp_path):
+    # a stateful policy (a step counter): two episodes at once on one object would interleave its
+    # counter, so equal bytes need one copy per worker
+    one = actionshift.evaluate(simple_policy.ReachGraspLift(), seed=3, episodes=6, out=str(tmp_path / "one"))
+    p = simple_policy.ReachGraspLift()
+    two = actionshift.evaluate(p, seed=3, episodes=6, out=str(tmp_path / "two"), threads=2)
+    assert two["job_id"] == one["job_id"]
+    assert (tmp_path / "two" / f"{two['job_id']}.jsonl").read_bytes() == \
+        (tmp_path / "one" / f"{one['job_id']}.jsonl").read_bytes()
+    assert p.t == 0  # the workers called their copies, not the object passed in
+    allcores = actionshift.evaluate(simple_policy.ReachGraspLift(), seed=3, episodes=6, out=str(tmp_path / "all"),
+                                    threads=0)
+    assert allcores["job_id"] == one["job_id"]
+
+
+def test_threads_errors(tmp_path):
+    import threading
+
+    class Uncopyable:
+        def __init__(self):
+            self.lock = threading.Lock()  # deepcopy cannot copy a lock
+
+        def __call__(self, obs):
+            return np.zeros(7)
+
+    with pytest.raises(ValueError, match=r"evaluate: threads: each of the 2 workers needs copy.deepcopy\(policy\)"):
+        actionshift.evaluate(Uncopyable(), episodes=2, out=str(tmp_path), threads=2)
+    assert not any(tmp_path.iterdir())  # nothing written
+    assert actionshift.evaluate(Uncopyable(), episodes=1, out=str(tmp_path), threads=1)["episodes_run"] == 1
+    with pytest.raises(ValueError, match="threads: must be 0"):
+        actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), threads=-1)
