@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -154,6 +155,8 @@ void ResultStore::adopt_from_sibling(const std::string& out_dir, const StoreOpti
   std::error_code ec;
   std::vector<EpisodeRecord> best;
   std::string best_id;
+  const std::vector<std::string> markers = {'"' + job_.split.sha256 + '"', '"' + job_.backbone.sha256 + '"',
+                                            nlohmann::json(job_.method).dump()};
   for (const auto& entry : fs::directory_iterator(out_dir, ec)) {
     const std::string name = entry.path().filename().string();
     const std::string suffix = ".summary.json";
@@ -162,8 +165,13 @@ void ResultStore::adopt_from_sibling(const std::string& out_dir, const StoreOpti
     if (id == id_ || !is_sha256_hex(id)) continue;
     const fs::path jsonl = fs::path(out_dir) / jsonl_file_name(id);
     try {
-      std::ifstream in(entry.path(), std::ios::binary);
-      const nlohmann::json summary = nlohmann::json::parse(in);
+      // a sibling has this job's split, backbone and method: a summary whose text lacks one of
+      // them is skipped unparsed (a directory of a thousand jobs would otherwise cost every new job
+      // a thousand JSON parses)
+      const std::string text = detail::read_file(entry.path().string());
+      if (!std::all_of(markers.begin(), markers.end(), [&](const std::string& m) { return text.find(m) != std::string::npos; }))
+        continue;
+      const nlohmann::json summary = nlohmann::json::parse(text);
       const JobSpec other = job_from_json(summary.at("job"), entry.path().string());
       if (eval::job_id(other) != id || family_key(other) != family || !fs::exists(jsonl)) continue;
       RecordFile rf = read_record_file(jsonl.string(), /*allow_torn_tail=*/true);
