@@ -240,6 +240,8 @@ urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::str
   // urdfdom links own their children (shared_ptr) and point to their parent weakly; a joint closing a
   // kinematic loop makes an ownership cycle that would outlive the model. The returned handle owns the
   // model and cuts every child list when it is released, so a rejected loop frees everything.
+  // joint_graph_problem rejects loops first, but only in files TinyXML reads; this cut also covers
+  // the rest.
   return urdf::ModelInterfaceSharedPtr(model.get(), [model](urdf::ModelInterface*) {
     for (auto& [name, link] : model->links_)
       if (link) {
