@@ -11,8 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -52,9 +55,50 @@ void ensure_parent(const std::string& path) {
   if (ec) throw InputError(parent.string(), "", "cannot create directory: " + ec.message());
 }
 
+// Ctrl-C (SIGINT) and SIGTERM (what Slurm sends at a time limit) during a job: the first stops it
+// after the episodes already finished, with the summary saying where (exit 130, re-run to resume);
+// a second one ends the process at once. Signals ignored when the process started stay ignored.
+std::atomic<bool> g_interrupt{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+extern "C" void on_interrupt_signal(int sig) {
+  if (g_interrupt.exchange(true)) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+}
+
+class InterruptHandlers {
+ public:
+  InterruptHandlers() {
+    g_interrupt = false;
+    install(SIGINT, old_int_, has_int_);
+    install(SIGTERM, old_term_, has_term_);
+  }
+  ~InterruptHandlers() {
+    if (has_int_) sigaction(SIGINT, &old_int_, nullptr);
+    if (has_term_) sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  InterruptHandlers(const InterruptHandlers&) = delete;
+  InterruptHandlers& operator=(const InterruptHandlers&) = delete;
+
+ private:
+  static void install(int sig, struct sigaction& old, bool& has) {
+    if (sigaction(sig, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) return;
+    struct sigaction sa {};
+    sa.sa_handler = on_interrupt_signal;
+    sigemptyset(&sa.sa_mask);
+    has = sigaction(sig, &sa, nullptr) == 0;
+  }
+  struct sigaction old_int_ {}, old_term_ {};
+  bool has_int_{false}, has_term_{false};
+};
+
 eval::RunResult run_with(const eval::JobSpec& job, const RunPlanOptions& o, const EpisodeFnFactory& make,
                          std::ostream& out, std::ostream& err) {
+  const InterruptHandlers handlers;
   eval::RunOptions ro;
+  ro.interrupted = [] { return g_interrupt.load(); };
   ro.threads = o.threads;
   ro.out_dir = o.out_dir;
   ro.progress = parse_progress_mode(o.progress);

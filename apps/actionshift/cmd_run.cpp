@@ -98,6 +98,8 @@ int run_run(const RunCliOptions& o) {
     }
     const EpisodeFnFactory factory = [options](const eval::JobSpec& j) { return eval::make_episode_fn(j, options); };
     return run_one_job(job, o.run, factory);
+  } catch (const eval::Interrupted&) {
+    throw;  // not an error: main says where the job stopped (exit 130)
   } catch (const std::exception& e) {
     std::cerr << "actionshift: error: " << e.what() << "\n";
     return kBadInput;

@@ -1,6 +1,7 @@
 // The actionshift command-line tool: the only translation unit that includes CLI11.
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
-// Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage. One-line errors on stderr.
+// Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage, 130 a job stopped by Ctrl-C or
+// SIGTERM. One-line errors on stderr.
 #include "cmd_bench_adapt.hpp"
 #include "cmd_identifier.hpp"
 #include "cmd_policy.hpp"
@@ -8,6 +9,8 @@
 #include "cmd_run.hpp"
 #include "cmd_selftest.hpp"
 #include "commands.hpp"
+
+#include "actionshift/eval/runner.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -292,7 +295,8 @@ int main(int argc, char** argv) {
       "Run an evaluation job: episodes of a backbone under each contract of a split, through a method's\n"
       "adapter, written as one JSONL record per episode to <out>/<job id>.jsonl (+ .summary.json). The job\n"
       "id is the SHA-256 of everything that determines the episodes; a finished job is a no-op and a killed\n"
-      "one resumes. Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
+      "one resumes. Ctrl-C or SIGTERM stops it after the episodes already finished (exit 130; a second\n"
+      "signal ends it at once). Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
   run->add_option("--task", run_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
   run->add_option("--split", run_o.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
   run->add_option("--method", run_o.request.method.name,
@@ -512,6 +516,9 @@ int main(int argc, char** argv) {
   }
   try {
     return action ? action() : cli::kBadInput;
+  } catch (const eval::Interrupted& e) {  // Ctrl-C or SIGTERM during a job: its summary says where it stopped
+    std::cerr << "actionshift: " << e.what() << "; re-run the same command to resume\n";
+    return cli::kInterrupted;
   } catch (const std::exception& e) {
     std::cerr << "actionshift: error: " << e.what() << "\n";
     return cli::kBadInput;

@@ -609,11 +609,30 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   else if (progress == "bar") ro.progress = eval::ProgressMode::bar;
   else if (progress == "auto") ro.progress = eval::ProgressMode::automatic;
   else throw InputError("progress", "", "expected auto, bar, lines or off (got \"" + progress + "\")");
+  // Ctrl-C: Python runs signal handlers only on the main thread, which waits inside run_job without
+  // the GIL; the runner polls this hook there, so a KeyboardInterrupt stops the job (the finished
+  // episodes are kept and the job resumes on the next call) and is raised here
+  std::optional<py::error_already_set> signal_error;
+  ro.interrupted = [&signal_error] {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    signal_error.emplace();  // takes the pending exception (KeyboardInterrupt)
+    return true;
+  };
   eval::RunResult r;
+  bool interrupted = false;
   {
     const eval::EpisodeFn fn = eval::make_episode_fn(job, prototype);
     py::gil_scoped_release release;
-    r = eval::run_job(job, fn, ro);
+    try {
+      r = eval::run_job(job, fn, ro);
+    } catch (const eval::Interrupted&) {
+      interrupted = true;
+    }
+  }
+  if (interrupted) {
+    signal_error->restore();
+    throw py::error_already_set();
   }
   py::dict d;
   d["job_id"] = r.job_id;

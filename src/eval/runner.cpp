@@ -190,10 +190,34 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
 
   Progress progress(options.progress, log, store.job_id(), first, job.episodes);
   std::exception_ptr write_failure;
+  bool was_interrupted = false;
   {
     std::unique_lock lock(mu);
+    const auto next_or_failed = [&] { return ready.count(written) || (failure && written >= failed_at); };
+    // options.interrupted, at most every 100 ms (episodes may finish faster than that); the lock is
+    // held on entry and exit but not during the call
+    auto last_poll = Clock::now();
+    const auto poll_interrupted = [&] {
+      if (Clock::now() - last_poll < std::chrono::milliseconds(100)) return;
+      last_poll = Clock::now();
+      lock.unlock();
+      const bool stop = options.interrupted();
+      lock.lock();
+      if (stop && (!failure || written < failed_at)) {
+        failure = std::make_exception_ptr(
+            Interrupted("interrupted after " + std::to_string(written) + " of " + std::to_string(job.episodes) + " episodes"));
+        failed_at = written;
+        was_interrupted = true;
+        cv.notify_all();
+      }
+    };
     while (written < job.episodes) {
-      cv.wait(lock, [&] { return ready.count(written) || (failure && written >= failed_at); });
+      if (!options.interrupted) {
+        cv.wait(lock, next_or_failed);
+      } else {
+        while (!cv.wait_for(lock, std::chrono::milliseconds(100), next_or_failed)) poll_interrupted();
+        poll_interrupted();
+      }
       if (!ready.count(written)) break;  // the next episode failed: stop at the last contiguous record
       EpisodeRecord r = std::move(ready.at(written));
       ready.erase(written);
@@ -224,7 +248,10 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
   result.episodes_run = store.episodes_done() - first;
   result.wall_time_s = seconds_since(t0);
   std::string message;
-  if (failure) {
+  if (failure && was_interrupted) {
+    message = "interrupted after " + std::to_string(store.episodes_done()) + " of " + std::to_string(job.episodes) +
+              " episodes; re-run to resume";
+  } else if (failure) {
     message = "stopped at episode " + std::to_string(failed_at) + " of " + std::to_string(job.episodes) +
               "; re-run to resume";
   } else {
@@ -241,6 +268,9 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
       log << "\nactionshift: note: job summary not written either (" << e.what() << ")\n";
     }
     if (options.progress != ProgressMode::off) log << "\n";
+    if (was_interrupted)  // the count of the summary: episodes that finished after the signal are kept too
+      throw Interrupted("interrupted after " + std::to_string(store.episodes_done()) + " of " +
+                        std::to_string(job.episodes) + " episodes");
     std::rethrow_exception(failure);
   }
   write_json_atomic(store.summary_path(),

@@ -42,6 +42,30 @@ run "$AS" run --task pick_cube --split seen --method entropy_probes --pool full 
 expect_rc 0 "resume after SIGKILL"
 cmp -s "$TMP/full/$KID" "$TMP/kill/$KID" && ok || bad "resumed JSONL differs from the uninterrupted run"
 
+# ---- SIGTERM (what Slurm sends; Ctrl-C's SIGINT takes the same path) stops the job after the
+# finished episodes: exit 130, the summary says where, and the same command resumes
+"$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
+  --out "$TMP/term" --progress off > "$TMP/term.out" 2> "$TMP/term.err" &
+PID=$!
+for _ in $(seq 1 200); do
+  n=$(cat "$TMP"/term/*.jsonl 2>/dev/null | wc -l || true)
+  [ "${n:-0}" -ge 10 ] && break
+  sleep 0.02
+done
+kill -TERM "$PID" 2>/dev/null || true
+rc=0; wait "$PID" || rc=$?
+[ "$rc" = 130 ] && ok || bad "SIGTERM: exit $rc, expected 130 ($(cat "$TMP/term.err"))"
+term_lines=$(wc -l < "$TMP/term/$KID" || echo 0)
+[ "$term_lines" -lt 96 ] && ok || bad "the job finished before SIGTERM ($term_lines lines)"
+grep -qx "actionshift: interrupted after $term_lines of 96 episodes; re-run the same command to resume" "$TMP/term.err" \
+  && ok || bad "SIGTERM message: $(cat "$TMP/term.err")"
+grep -q "\"message\": \"interrupted after $term_lines of 96 episodes; re-run to resume\"" "$TMP/term/${KID%.jsonl}.summary.json" \
+  && ok || bad "the summary does not say where the job stopped"
+run "$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
+  --out "$TMP/term" --progress off
+expect_rc 0 "resume after SIGTERM"
+cmp -s "$TMP/full/$KID" "$TMP/term/$KID" && ok || bad "JSONL resumed after SIGTERM differs from the uninterrupted run"
+
 # ---- smoke plan, Gate 1 and the committed expected verdicts
 run "$AS" plan --experiment "$SRC/configs/experiments/smoke.yaml" --out "$TMP/smoke"
 expect_rc 0 "plan smoke"

@@ -148,6 +148,41 @@ TEST_F(RunnerTest, FailingEpisodeKeepsEarlierRecordsAndResumes) {
   EXPECT_EQ(slurp(path), slurp(ref.jsonl_path));
 }
 
+TEST_F(RunnerTest, InterruptedJobKeepsItsFinishedEpisodesAndResumes) {
+  const JobSpec job = testing::fake_job(200);
+  // episodes of 2 ms; the hook says stop once 20 episodes have been run
+  std::atomic<int> ran{0};
+  auto slow = [&ran, base = testing::fake_episode_fn()](const EpisodeTask& t) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ++ran;
+    return base(t);
+  };
+  std::atomic<int> polls{0};
+  RunOptions o = opts("x", 2);
+  o.interrupted = [&] {
+    ++polls;
+    return ran.load() >= 20;
+  };
+  EXPECT_THROW(run_job(job, slow, o), Interrupted);
+  EXPECT_GT(polls.load(), 0);
+  const auto path = root_ / "x" / (job_id(job) + ".jsonl");
+  const std::size_t kept = read_record_file(path.string()).records.size();
+  EXPECT_GE(kept, 1u);
+  EXPECT_LT(kept, 200u);  // stopped early: 200 episodes take at least 200 ms on 2 workers, a poll comes every 100 ms
+  const auto summary = nlohmann::json::parse(slurp(root_ / "x" / (job_id(job) + ".summary.json")));
+  EXPECT_EQ(summary["message"].get<std::string>(),
+            "interrupted after " + std::to_string(kept) + " of 200 episodes; re-run to resume");
+  // resuming runs only the rest, and the file equals an uninterrupted run; a hook that never stops
+  // the job changes nothing
+  RunOptions again = opts("x", 2);
+  again.interrupted = [] { return false; };
+  const auto r = run_job(job, slow, again);
+  EXPECT_EQ(r.episodes_before, static_cast<std::int64_t>(kept));
+  EXPECT_EQ(r.episodes_run, 200 - static_cast<std::int64_t>(kept));
+  const auto ref = run_job(job, testing::fake_episode_fn(), opts("ref", 1));
+  EXPECT_EQ(slurp(path), slurp(ref.jsonl_path));
+}
+
 // a full disk (here: a file-size limit) fails the JSONL append first; the summary written afterwards
 // fails too, and its error must not hide the first one
 TEST_F(RunnerTest, FirstIoErrorIsTheOneReported) {

@@ -1,5 +1,6 @@
 """evaluate(): a Python callable as the backbone, in process, writes exactly the job of the CLI's
 external-process backbone running the same policy."""
+import json
 import os
 import sys
 
@@ -98,3 +99,36 @@ def test_threads_errors(tmp_path):
     assert actionshift.evaluate(Uncopyable(), episodes=1, out=str(tmp_path), threads=1)["episodes_run"] == 1
     with pytest.raises(ValueError, match="threads: must be 0"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), threads=-1)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_ctrl_c_stops_evaluate_and_the_job_resumes(tmp_path, threads):
+    import signal
+
+    class InterruptsItself:
+        """A zero policy that sends this process SIGINT (what Ctrl-C does) once, at the 100th call of
+        one of its copies (the flag is the class's, so the workers' copies share it)."""
+        sent = False
+
+        def __init__(self):
+            self.calls = 0
+
+        def __call__(self, obs):
+            self.calls += 1
+            if self.calls == 100 and not InterruptsItself.sent:
+                InterruptsItself.sent = True
+                os.kill(os.getpid(), signal.SIGINT)
+            return np.zeros(7)
+
+    with pytest.raises(KeyboardInterrupt):
+        actionshift.evaluate(InterruptsItself(), seed=4, episodes=300, out=str(tmp_path / "x"), threads=threads,
+                             backbone="python:zero")
+    jsonl = next((tmp_path / "x").glob("*.jsonl"))
+    kept = jsonl.read_bytes().count(b"\n")
+    assert kept < 300  # 300 episodes of 50 steps take seconds; the runner polls for Ctrl-C every 100 ms
+    summary = json.loads(next((tmp_path / "x").glob("*.summary.json")).read_text())
+    assert summary["message"] == f"interrupted after {kept} of 300 episodes; re-run to resume"
+    # the next call resumes where it stopped
+    r = actionshift.evaluate(lambda obs: np.zeros(7), seed=4, episodes=300, out=str(tmp_path / "x"),
+                             threads=threads, backbone="python:zero")
+    assert r["episodes_before"] == kept and r["episodes_run"] == 300 - kept

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <stdexcept>
 #include <string>
 
 namespace actionshift::eval {
@@ -57,6 +58,16 @@ struct RunOptions {
   ProgressMode progress{ProgressMode::automatic};  ///< progress display
   bool fsync{false};                   ///< fsync after every line
   std::ostream* log{nullptr};          ///< progress and repair messages; nullptr: std::cerr
+  /// Polled by the calling thread about every 100 ms while it waits for episodes (not by the
+  /// workers). Returning true stops the job as a failing episode would: no new episode starts, the
+  /// finished ones are written in order, the summary says where it stopped, and run_job throws
+  /// Interrupted. Python's evaluate() checks for Ctrl-C here.
+  std::function<bool()> interrupted;
+};
+
+/// Thrown by run_job when RunOptions::interrupted returned true.
+struct Interrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 /// What run_job did.
