@@ -309,25 +309,28 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
         if (o.policy_files) pj.spec.policy_files = o.policy_files;
         pj.job_id = eval::job_id(pj.spec);
       }
-    const std::string plan_path =
-        o.plan_file.empty() ? (fs::path(o.out_dir) / (ex.name + ".plan.json")).string() : o.plan_file;
-    ensure_parent(plan_path);
-    eval::write_plan(plan_path, plan);
-    out << "plan " << ex.name << ": " << plan.jobs.size() << " jobs -> " << plan_path << "\n";
-    if (o.slurm) {
+    if (o.slurm) {  // the Slurm options are checked before any file is written
       if (!eval::valid_slurm_time(o.time_limit))
         throw InputError("--time", o.time_limit,
                          "not a Slurm time (M, M:S, H:M:S, D-H, D-H:M, D-H:M:S or UNLIMITED, not zero)");
       if (!o.mem.empty() && !eval::valid_slurm_mem(o.mem))
         throw InputError("--mem", o.mem, "not a Slurm memory size (a positive integer with an optional K, M, G or T)");
       if (o.cpus_per_task == 0) throw InputError("--cpus-per-task", "0", "must be at least 1");
+    }
+    const std::string executable = o.slurm ? resolve_executable(o.executable) : std::string();
+    const std::string plan_path =
+        o.plan_file.empty() ? (fs::path(o.out_dir) / (ex.name + ".plan.json")).string() : o.plan_file;
+    ensure_parent(plan_path);
+    eval::write_plan(plan_path, plan);
+    out << "plan " << ex.name << ": " << plan.jobs.size() << " jobs -> " << plan_path << "\n";
+    if (o.slurm) {
       std::error_code ec;
       fs::create_directories(o.out_dir, ec);  // Slurm does not create the --output directory
       if (ec) throw InputError(o.out_dir, "", "cannot create directory: " + ec.message());
       eval::SlurmOptions so;
       so.plan_path = fs::absolute(plan_path).lexically_normal().string();
       so.out_dir = fs::absolute(o.out_dir).lexically_normal().string();
-      so.executable = resolve_executable(o.executable);
+      so.executable = executable;
       so.cpus_per_task = o.cpus_per_task;
       so.time_limit = o.time_limit;
       so.mem = o.mem;

@@ -10,6 +10,7 @@
 #include "cmd_selftest.hpp"
 #include "commands.hpp"
 
+#include "actionshift/adapt/registry.hpp"
 #include "actionshift/eval/runner.hpp"
 
 #include <CLI/CLI.hpp>
@@ -299,8 +300,9 @@ int main(int argc, char** argv) {
       "signal ends it at once). Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
   run->add_option("--task", run_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
   run->add_option("--split", run_o.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
-  run->add_option("--method", run_o.request.method.name,
-                  "oracle, no_adapt, exact_belief, fixed_probes, random_probes, entropy_probes, dualabi");
+  std::string method_list;  // the registry's names, so the help cannot fall behind it
+  for (const std::string& m : adapt::method_names()) method_list += (method_list.empty() ? "" : ", ") + m;
+  run->add_option("--method", run_o.request.method.name, "Adapter method (docs/adapters.md): " + method_list);
   run->add_option("--params", run_o.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
       ->capture_default_str();
   run->add_option("--seed", run_o.request.seed, "Experimental seed")->capture_default_str();

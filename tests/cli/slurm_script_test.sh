@@ -57,4 +57,6 @@ expect_rc 2 "missing --executable"
 expect_err "not found on PATH" "missing --executable message"
 run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad" --slurm --executable "$TMP/exp.yaml"
 expect_rc 2 "non-executable --executable"
+# none of the refused Slurm options left a file behind (the plan is checked before it is written)
+[ ! -e "$TMP/bad" ] && ok || bad "a refused Slurm option left files: $(ls -R "$TMP/bad" 2>&1)"
 finish
