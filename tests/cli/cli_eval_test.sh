@@ -21,17 +21,23 @@ run "$AS" run --task pick_cube --split seen --method oracle --episodes 24 --thre
 expect_out "already complete" "re-run of a finished job"
 [ "$(sha256sum "$TMP/t1/$ID")" = "$before" ] && ok || bad "re-run changed the file"
 
+# wait_for_records DIR N: until the job's JSONL in DIR has N records (at most 4 s)
+wait_for_records() {
+  local n
+  for _ in $(seq 1 200); do
+    n=$(cat "$1"/*.jsonl 2>/dev/null | wc -l || true)
+    [ "${n:-0}" -ge "$2" ] && return
+    sleep 0.02
+  done
+}
+
 # ---- SIGKILL mid-run, resume, compare with the uninterrupted run
 "$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
   --out "$TMP/full" --progress off > /dev/null 2>&1
 "$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
   --out "$TMP/kill" --progress off > /dev/null 2>&1 &
 PID=$!
-for _ in $(seq 1 200); do
-  n=$(cat "$TMP"/kill/*.jsonl 2>/dev/null | wc -l || true)
-  [ "${n:-0}" -ge 10 ] && break
-  sleep 0.02
-done
+wait_for_records "$TMP/kill" 10
 kill -9 "$PID" 2>/dev/null || true
 wait "$PID" 2>/dev/null || true
 KID=$(ls "$TMP/full" | grep '\.jsonl$')
@@ -47,11 +53,7 @@ cmp -s "$TMP/full/$KID" "$TMP/kill/$KID" && ok || bad "resumed JSONL differs fro
 "$AS" run --task pick_cube --split seen --method entropy_probes --pool full --episodes 96 --threads 2 \
   --out "$TMP/term" --progress off > "$TMP/term.out" 2> "$TMP/term.err" &
 PID=$!
-for _ in $(seq 1 200); do
-  n=$(cat "$TMP"/term/*.jsonl 2>/dev/null | wc -l || true)
-  [ "${n:-0}" -ge 10 ] && break
-  sleep 0.02
-done
+wait_for_records "$TMP/term" 10
 kill -TERM "$PID" 2>/dev/null || true
 rc=0; wait "$PID" || rc=$?
 [ "$rc" = 130 ] && ok || bad "SIGTERM: exit $rc, expected 130 ($(cat "$TMP/term.err"))"
