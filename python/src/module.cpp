@@ -511,8 +511,11 @@ double bench_cpp_steps(const std::string& task, const DArray& actions, std::uint
 
 // ---------------------------------------------------------------- in-process backbone
 
+// copy.deepcopy(obj); the GIL must be held
+py::object deepcopy(const py::object& obj) { return py::module_::import("copy").attr("deepcopy")(obj); }
+
 // A Python callable obs -> 7 numbers as a policy::Policy. reset() calls the object's `reset()`
-// method if it has one. Every clone shares the one Python object, so run it with one thread.
+// method if it has one. Clones share the one Python object (one worker), or each is a deep copy.
 class PythonPolicy final : public policy::Policy {
  public:
   // copy_per_worker: every clone() is a copy.deepcopy of the callable (one per runner worker, as the
@@ -541,7 +544,7 @@ class PythonPolicy final : public policy::Policy {
   std::unique_ptr<policy::Policy> clone() const override {
     py::gil_scoped_acquire gil;
     if (!copy_) return std::make_unique<PythonPolicy>(*fn_, name_, sha_, task_);
-    return std::make_unique<PythonPolicy>(py::module_::import("copy").attr("deepcopy")(*fn_), name_, sha_, task_);
+    return std::make_unique<PythonPolicy>(deepcopy(*fn_), name_, sha_, task_);
   }
 
  private:
@@ -592,11 +595,12 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   const unsigned workers = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : static_cast<unsigned>(threads);
   if (workers > 1) {
     try {
-      py::module_::import("copy").attr("deepcopy")(policy);
+      deepcopy(policy);
     } catch (py::error_already_set& e) {
+      const std::string why = e.what();
       throw InputError("evaluate", "threads",
                        "each of the " + std::to_string(workers) + " workers needs copy.deepcopy(policy), which failed (" +
-                           std::string(e.what()).substr(0, std::string(e.what()).find('\n')) + "); use threads=1");
+                           why.substr(0, why.find('\n')) + "); use threads=1");
     }
   }
   auto prototype =

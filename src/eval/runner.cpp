@@ -204,8 +204,8 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
       const bool stop = options.interrupted();
       lock.lock();
       if (stop && (!failure || written < failed_at)) {
-        failure = std::make_exception_ptr(
-            Interrupted("interrupted after " + std::to_string(written) + " of " + std::to_string(job.episodes) + " episodes"));
+        // stops the workers like a failing episode; what is thrown is said after the last write
+        failure = std::make_exception_ptr(Interrupted("interrupted"));
         failed_at = written;
         was_interrupted = true;
         cv.notify_all();
@@ -248,9 +248,11 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
   result.episodes_run = store.episodes_done() - first;
   result.wall_time_s = seconds_since(t0);
   std::string message;
+  // the count of the summary: episodes that finished after the signal are written too
+  const std::string interrupted_after =
+      "interrupted after " + std::to_string(store.episodes_done()) + " of " + std::to_string(job.episodes) + " episodes";
   if (failure && was_interrupted) {
-    message = "interrupted after " + std::to_string(store.episodes_done()) + " of " + std::to_string(job.episodes) +
-              " episodes; re-run to resume";
+    message = interrupted_after + "; re-run to resume";
   } else if (failure) {
     message = "stopped at episode " + std::to_string(failed_at) + " of " + std::to_string(job.episodes) +
               "; re-run to resume";
@@ -268,9 +270,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
       log << "\nactionshift: note: job summary not written either (" << e.what() << ")\n";
     }
     if (options.progress != ProgressMode::off) log << "\n";
-    if (was_interrupted)  // the count of the summary: episodes that finished after the signal are kept too
-      throw Interrupted("interrupted after " + std::to_string(store.episodes_done()) + " of " +
-                        std::to_string(job.episodes) + " episodes");
+    if (was_interrupted) throw Interrupted(interrupted_after);
     std::rethrow_exception(failure);
   }
   write_json_atomic(store.summary_path(),
