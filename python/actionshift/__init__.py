@@ -19,6 +19,7 @@ from ._native import (  # noqa: F401  (re-exported API)
     Contract,
     Decoder,
     InputError,
+    MAX_NUM_ENVS,
     Manifest,
     SelfTest,
     builtin_manifests,
@@ -102,6 +103,30 @@ _TASK_IDS = {
 }
 
 
+def _check_seed(seed, name="seed"):
+    # seeds are unsigned 64-bit integers in the library (None: the next seed of a sequence)
+    if seed is not None and (not isinstance(seed, (int, _np.integer)) or isinstance(seed, bool)
+                             or not 0 <= seed < 2 ** 64):
+        raise ValueError(f"{name}: must be an integer in [0, 2**64) (got {seed!r})")
+
+
+def _check_types(where, **values):
+    # one-line TypeErrors for the constructor arguments (pybind11's own message spans many lines)
+    kinds = {"task": (str,), "split": (str, type(None)), "rotation": (str,), "profile": (str,),
+             "index": (int, _np.integer), "num_envs": (int, _np.integer), "threads": (int, _np.integer)}
+    for name, value in values.items():
+        if not isinstance(value, kinds[name]) or isinstance(value, bool):
+            want = " or ".join("None" if t is type(None) else t.__name__ for t in kinds[name])
+            raise TypeError(f"{where}: {name}: expected {want} (got {type(value).__name__})")
+    # ranges the native layer's integer types hold (the split's own size is checked there)
+    if "index" in values and not -2 ** 62 < values["index"] < 2 ** 62:
+        raise ValueError(f"{where}: index: out of range (got {values['index']})")
+    if "threads" in values and not 0 <= values["threads"] <= 4096:
+        raise ValueError(f"{where}: threads: must be 0 (all cores) or a count up to 4096 (got {values['threads']})")
+    if "num_envs" in values and not -2 ** 31 < values["num_envs"] < 2 ** 31:
+        raise ValueError(f"{where}: num_envs: must be between 1 and {MAX_NUM_ENVS} (got {values['num_envs']})")
+
+
 def _check_profile(profile):
     _native.env_config_check(profile)
 
@@ -119,6 +144,7 @@ class Env(_EnvBase):
     metadata = {"render_modes": []}
 
     def __init__(self, task="pick_cube", contract=None, split=None, index=0, rotation="live", profile="maniskill"):
+        _check_types("make", task=task, split=split, index=index, rotation=rotation, profile=profile)
         self._env = _native._Env(task, contract, split, int(index), rotation, profile)
         n = self._env.obs_dim
         self.observation_space = _box(-_np.inf, _np.inf, (n,))
@@ -132,8 +158,7 @@ class Env(_EnvBase):
     def reset(self, *, seed=None, options=None):
         """Start an episode; the initial state is a pure function of ``seed`` (None: the next
         seed of this env's sequence, so ``reset(seed=s)`` then ``reset()`` is reproducible)."""
-        if seed is not None and (not isinstance(seed, (int, _np.integer)) or seed < 0):
-            raise ValueError(f"seed: must be a nonnegative integer (got {seed!r})")
+        _check_seed(seed)
         return self._env.reset(None if seed is None else int(seed))
 
     def step(self, action):
@@ -162,6 +187,8 @@ class VecEnv:
 
     def __init__(self, task="pick_cube", num_envs=1, contract=None, split=None, index=0, rotation="live",
                  profile="maniskill", threads=0):
+        _check_types("make_vec", task=task, num_envs=num_envs, split=split, index=index, rotation=rotation,
+                     profile=profile, threads=threads)
         self._env = _native._VecEnv(task, int(num_envs), contract, split, int(index), rotation, profile, int(threads))
         self.num_envs = self._env.num_envs
         n = self._env.obs_dim
@@ -174,8 +201,7 @@ class VecEnv:
 
     def reset(self, *, seed=None, options=None):
         """Reset every environment; environment i gets seed ``seed + i``."""
-        if seed is not None and (not isinstance(seed, (int, _np.integer)) or seed < 0):
-            raise ValueError(f"seed: must be a nonnegative integer (got {seed!r})")
+        _check_seed(seed)
         return self._env.reset(None if seed is None else int(seed))
 
     def step(self, actions):
@@ -234,6 +260,9 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     process per worker), the simulation runs in parallel and only the policy calls take turns on the
     GIL. A plain function is not copied by ``deepcopy``: it must not keep state between calls.
     """
+    if seed is None:
+        raise ValueError("seed: must be an integer in [0, 2**64) (got None)")
+    _check_seed(seed)
     if backbone is None:
         target = policy if hasattr(policy, "__qualname__") else type(policy)
         backbone = f"python:{getattr(target, '__module__', '?')}.{target.__qualname__}"

@@ -41,6 +41,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -65,12 +66,14 @@ std::string shape_of(const DArray& a) {
   return s.str();
 }
 
+// pybind11's ensure() returns a null array (its error cleared) when h cannot be converted
 DArray as_array(py::handle h, const char* what) {
-  try {
-    return DArray::ensure(h);
-  } catch (const py::error_already_set&) {
+  DArray a = DArray::ensure(h);
+  if (!a) {
+    PyErr_Clear();
+    value_error(std::string(what) + ": not convertible to an array of numbers");
   }
-  value_error(std::string(what) + ": not convertible to an array of numbers");
+  return a;
 }
 
 // a 1-D array of exactly n numbers (a list, tuple or numpy array of any numeric dtype)
@@ -213,6 +216,23 @@ py::dict step_info(const sim::StepResult& r, const sim::EpisodeStats& st) {
   return info;
 }
 
+// a seed from Python: an integer in [0, 2**64), else a one-line ValueError (pybind11's own message
+// for a failed conversion spans several lines)
+std::uint64_t to_seed(py::handle h, const char* what) {
+  const auto fail = [&] {
+    PyErr_Clear();
+    std::string got = py::repr(h);
+    if (got.size() > 40 || got.find('\n') != std::string::npos) got = std::string("a ") + Py_TYPE(h.ptr())->tp_name;
+    value_error(std::string(what) + ": must be an integer in [0, 2**64) (got " + got + ")");
+  };
+  if (py::isinstance<py::bool_>(h)) fail();
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr()));  // int, numpy integer
+  if (!index) fail();
+  const unsigned long long v = PyLong_AsUnsignedLongLong(index.ptr());
+  if (PyErr_Occurred()) fail();
+  return static_cast<std::uint64_t>(v);
+}
+
 std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
   last = last ? eval::splitmix64(*last) : 0;
   return *last;
@@ -243,6 +263,7 @@ class PyEnv {
   }
 
   py::tuple step(py::handle action) {
+    if (!last_seed_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
     DArray a = DArray::ensure(action);
     if (!a) {
       PyErr_Clear();
@@ -361,12 +382,17 @@ class WorkerPool {
 // environment i with seed + i. An environment whose episode ends (terminated or truncated) is
 // reset in the same call: the returned row is the new episode's first observation and
 // info["final_obs"][i] the last one of the ended episode.
+// each environment holds its own Bullet world, about 0.2 MB once reset: 4096 of them take about 1 GB
+constexpr int kMaxNumEnvs = 4096;
+
 class PyVecEnv {
  public:
   PyVecEnv(const std::string& task, int num_envs, py::handle contract, std::optional<std::string> split,
            std::int64_t index, const std::string& rotation, const std::string& profile, unsigned threads)
       : model_(env_model(sim::parse_task(task), profile)) {
-    if (num_envs < 1) throw InputError("make_vec", "num_envs", "must be at least 1 (got " + std::to_string(num_envs) + ")");
+    if (num_envs < 1 || num_envs > kMaxNumEnvs)
+      throw InputError("make_vec", "num_envs", "must be between 1 and " + std::to_string(kMaxNumEnvs) + " (got " +
+                                                   std::to_string(num_envs) + ")");
     const sim::FrameRotation rot = parse_rotation(rotation);
     std::vector<Contract> contracts;
     if (split && contract.is_none()) {
@@ -408,6 +434,7 @@ class PyVecEnv {
   }
 
   py::tuple step(py::handle actions) {
+    if (!last_seed_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
     DArray a = DArray::ensure(actions);
     if (!a) {
       PyErr_Clear();
@@ -586,6 +613,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.rotation_mode = rotation;
   q.seed = seed;
   q.episodes = episodes;
+  q.source = "evaluate";
   eval::PlanResolver resolver = eval::default_resolver();
   resolver.backbone = [](const std::string&, const std::string& name) { return backbone_ref(name); };
   const eval::JobSpec job = eval::resolve_job(q, resolver);
@@ -887,7 +915,12 @@ PYBIND11_MODULE(_native, m) {
              std::unique_ptr<bool[]> mask;
              std::span<const bool> mask_span;
              if (!reset_mask.is_none()) {
-               const auto v = reset_mask.cast<std::vector<bool>>();
+               std::vector<bool> v;
+               try {
+                 v = reset_mask.cast<std::vector<bool>>();
+               } catch (const py::cast_error&) {
+                 value_error("reset_mask: must be " + std::to_string(n) + " booleans");
+               }
                if (static_cast<int>(v.size()) != n) value_error("reset_mask: must have " + std::to_string(n) + " flags");
                mask = std::make_unique<bool[]>(v.size());
                std::copy(v.begin(), v.end(), mask.get());
@@ -964,12 +997,14 @@ PYBIND11_MODULE(_native, m) {
   });
   m.def("_bench_cpp_steps", &bench_cpp_steps, py::arg("task"), py::arg("actions"), py::arg("seed"),
         py::arg("profile") = "maniskill");
+  m.attr("MAX_NUM_ENVS") = kMaxNumEnvs;
   m.def("env_config_check", [](const std::string& profile) { env_config_for_profile(profile); }, py::arg("profile"));
 
   // ---- adapters
   py::class_<adapt::Adapter>(m, "Adapter", "An adapter: begin_episode / encode / observe (docs/adapters.md).")
       .def_property_readonly("name", &adapt::Adapter::name)
-      .def("begin_episode", &adapt::Adapter::begin_episode, py::arg("episode_seed"))
+      .def("begin_episode", [](adapt::Adapter& a, py::handle seed) { a.begin_episode(to_seed(seed, "episode_seed")); },
+           py::arg("episode_seed"))
       .def("encode", [](adapt::Adapter& a, py::handle canonical, py::handle R) {
              return vec_out(a.encode(to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R")));
            }, py::arg("canonical"), py::arg("R") = py::none())

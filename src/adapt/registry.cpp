@@ -175,10 +175,10 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
         load_identifier_cached(identifier_weights_path(p.at("weights").get<std::string>(), *kind), *kind), o);
   }
   if (method == "oracle") {
-    if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given only by the runner)");
+    if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given by the runner; truth= in Python)");
     return std::make_unique<OracleAdapter>(*in.truth);
   }
-  if (!in.pool || in.pool->empty()) throw InputError("method", method, "needs a pool (--pool)");
+  if (!in.pool || in.pool->empty()) throw InputError("method", method, "needs a pool of candidate contracts (--pool on the command line, pool= in Python)");
   if (!in.model) throw InputError("method", method, "needs a response calibration");
   if (method == "exact_belief") return std::make_unique<ExactBeliefAdapter>(*in.pool, *in.model);
   if (method == "fixed_probes") return std::make_unique<ProbingAdapter>(*in.pool, *in.model, ProbeStrategy::kFixed, probe_options(p));

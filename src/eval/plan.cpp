@@ -302,7 +302,7 @@ Experiment load_experiment(const std::string& path) {
 
 JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("resolve_job: resolver needs split and backbone");
-  if (q.pool && !resolver.pool) throw InputError("command line", "pool", "pools cannot be resolved here");
+  if (q.pool && !resolver.pool) throw InputError(q.source, "pool", "pools cannot be resolved here");
   if (resolver.check_method) resolver.check_method(q.method);
   JobSpec job;
   job.task = q.task;
@@ -317,7 +317,7 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.seed = q.seed;
   job.episodes = q.episodes;
   job.obs_noise = q.obs_noise;
-  validate_job(job, "command line");
+  validate_job(job, q.source);
   return job;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace actionshift::sim {
 
@@ -151,7 +152,16 @@ const EnvModel& Env::model() const { return *impl_->model; }
 const StepResult& Env::last() const { return impl_->last; }
 const EpisodeStats& Env::episode() const { return impl_->stats; }
 
+namespace {
+// the state accessors read the Bullet world, which holds a robot only after the first reset
+const detail::EnvImpl& require_started(const detail::EnvImpl& e, const char* what) {
+  if (!e.started) throw std::logic_error(std::string("Env::") + what + " called before reset");
+  return e;
+}
+}  // namespace
+
 Eigen::Matrix<double, 9, 1> Env::qpos() const {
+  require_started(*impl_, "qpos");
   const Eigen::VectorXd q = impl_->world->qpos();
   Eigen::Matrix<double, 9, 1> out;
   for (int i = 0; i < 7; ++i) out(i) = q(impl_->data->arm_bodies[static_cast<std::size_t>(i)]);
@@ -160,16 +170,23 @@ Eigen::Matrix<double, 9, 1> Env::qpos() const {
   return out;
 }
 
-Eigen::Isometry3d Env::tcp_pose_in_base() const { return impl_->model->arm().fk(qpos().head<7>()); }
+Eigen::Isometry3d Env::tcp_pose_in_base() const {
+  require_started(*impl_, "tcp_pose_in_base");
+  return impl_->model->arm().fk(qpos().head<7>());
+}
 
-Eigen::Isometry3d Env::tcp_pose() const { return impl_->world->base_pose() * tcp_pose_in_base(); }
+Eigen::Isometry3d Env::tcp_pose() const {
+  require_started(*impl_, "tcp_pose");
+  return impl_->world->base_pose() * tcp_pose_in_base();
+}
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> Env::finger_forces() const {
+  require_started(*impl_, "finger_forces");
   return {impl_->world->finger_contact_force(0, 0), impl_->world->finger_contact_force(1, 0)};
 }
 
 TaskSnapshot Env::snapshot() const {
-  const detail::EnvImpl& e = *impl_;
+  const detail::EnvImpl& e = require_started(*impl_, "snapshot");
   TaskSnapshot s;
   const Eigen::VectorXd q = e.world->qpos();
   const Eigen::VectorXd v = e.world->qvel();

@@ -5,6 +5,7 @@
 #include "actionshift/core/transforms.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace actionshift::sim {
@@ -21,6 +22,7 @@ struct HiddenEnvImpl {
   FrameRotation rotation;
   std::vector<Action> decoded;
   std::vector<Action> applied;
+  bool started{false};  // a first reset has built the world
 
   Mat3 frame_rotation() const {
     return rotation == FrameRotation::kLiveTcp ? Mat3(env.tcp_pose_in_base().linear()) : Mat3::Identity();
@@ -39,7 +41,9 @@ const Eigen::VectorXd& HiddenContractEnv::reset(std::uint64_t seed) {
   impl_->decoder.reset_all();
   impl_->decoded.clear();
   impl_->applied.clear();
-  return impl_->env.reset(seed);
+  const Eigen::VectorXd& obs = impl_->env.reset(seed);
+  impl_->started = true;
+  return obs;
 }
 
 const StepResult& HiddenContractEnv::step(const Action& raw) {
@@ -48,6 +52,7 @@ const StepResult& HiddenContractEnv::step(const Action& raw) {
 
 const StepResult& HiddenContractEnv::step(std::span<const double> raw) {
   detail::HiddenEnvImpl& h = *impl_;
+  if (!h.started) throw std::logic_error("HiddenContractEnv::step called before reset");
   if (h.env.last().episode_over()) return h.env.last();
   // the raw action is checked before it can touch the decoder state
   if (raw.size() != static_cast<std::size_t>(kActionDim)) return h.env.abort(SafetyFlag::kBadActionShape);

@@ -74,8 +74,10 @@ def test_entropy_probing_identifies_a_pool_member_in_the_simulator(member):
 def test_adapter_errors_are_value_errors():
     with pytest.raises(ValueError, match="method"):
         actionshift.make_adapter("telepathy", task=TASK)
-    with pytest.raises(ValueError, match="pool"):
+    with pytest.raises(ValueError, match=r"needs a pool of candidate contracts \(.*pool= in Python\)"):
         actionshift.make_adapter("entropy_probes", task=TASK)
+    with pytest.raises(ValueError, match=r"needs the true contract \(.*truth= in Python\)"):
+        actionshift.make_adapter("oracle", task=TASK)
     with pytest.raises(ValueError):
         actionshift.make_adapter("entropy_probes", task=TASK, pool="reference9", params={"budget": -1})
     with pytest.raises(ValueError, match="params: not a JSON object"):

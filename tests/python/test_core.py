@@ -111,3 +111,15 @@ def test_bad_manifest_file_raises_the_cli_message(tmp_path, cli):
     assert p.returncode == 2
     assert p.stderr.strip() == "actionshift: error: " + str(e.value)
     assert e.value.source == str(bad)
+
+
+@pytest.mark.parametrize("raw", ["x", None, object(), [[1, "a"]]])
+def test_decoder_batch_input_that_is_not_numbers_is_a_value_error(raw):
+    # the batch path used to dereference the null array pybind11 returns for such input (segfault)
+    d = actionshift.Decoder(actionshift.Contract.identity(), num_envs=2)
+    with pytest.raises(ValueError, match="raw: "):
+        d.step_batch(raw)
+    with pytest.raises(ValueError, match="R: "):
+        d.step_batch(np.zeros((2, 7)), R="x")
+    with pytest.raises(ValueError, match="reset_mask: must be 2 booleans"):
+        d.step_batch(np.zeros((2, 7)), reset_mask=object())

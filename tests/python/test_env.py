@@ -121,6 +121,51 @@ def test_bad_arguments_raise_value_errors():
         env.step(np.zeros((2, 7)))
 
 
+def one_line(excinfo):
+    return "\n" not in str(excinfo.value)
+
+
+def test_step_before_reset_raises_instead_of_crashing():
+    # a fresh env has no robot in its Bullet world until the first reset (this used to segfault)
+    env = actionshift.make("push_cube")
+    with pytest.raises(RuntimeError, match=r"step: called before reset\(\)") as e:
+        env.step(np.zeros(7))
+    assert one_line(e)
+    env.reset(seed=1)
+    assert env.step(np.zeros(7))[4]["safety"] == "none"
+
+
+@pytest.mark.parametrize("seed", [-1, 2 ** 64, 1.5, "7", True, np.zeros(3)])
+def test_out_of_range_or_non_integer_seeds_are_one_line_value_errors(seed):
+    env = actionshift.make("pick_cube")
+    with pytest.raises(ValueError, match=r"seed: must be an integer in \[0, 2\*\*64\)") as e:
+        env.reset(seed=seed)
+    assert one_line(e)
+    with pytest.raises(ValueError, match=r"episode_seed: must be an integer") as e:
+        actionshift.make_adapter("no_adapt").begin_episode(seed)
+    assert one_line(e)
+
+
+def test_largest_seed_and_numpy_integer_seeds_are_accepted():
+    env = actionshift.make("pick_cube")
+    assert env.reset(seed=2 ** 64 - 1)[1]["seed"] == 2 ** 64 - 1
+    assert np.array_equal(env.reset(seed=np.int64(5))[0], env.reset(seed=5)[0])
+    actionshift.make_adapter("no_adapt").begin_episode(np.uint64(3))
+
+
+@pytest.mark.parametrize("kwargs, error, pattern", [
+    ({"task": None}, TypeError, "make: task: expected str"),
+    ({"split": 3}, TypeError, "make: split: expected str or None"),
+    ({"index": "0"}, TypeError, "make: index: expected int"),
+    ({"split": "seen", "index": 2 ** 70}, ValueError, "make: index: out of range"),
+])
+def test_constructor_arguments_of_the_wrong_type_are_one_line_errors(kwargs, error, pattern):
+    args = {"task": "pick_cube", **kwargs}
+    with pytest.raises(error, match=pattern) as e:
+        actionshift.make(**args)
+    assert one_line(e)
+
+
 def test_gymnasium_registration_when_available():
     gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (optional; the module works without it)")
     env = gym.make("ActionShift/PickCube-v1")

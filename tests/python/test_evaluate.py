@@ -66,6 +66,11 @@ def test_evaluate_errors(tmp_path, cli):
         actionshift.evaluate("not callable", episodes=1, out=str(tmp_path))
     with pytest.raises(ValueError, match="profile"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), profile="no_such_profile")
+    # a job's field errors name evaluate(), not the command line
+    with pytest.raises(ValueError, match=r"^evaluate: episodes: must be > 0 \(got 0\)$"):
+        actionshift.evaluate(lambda obs: np.zeros(7), episodes=0, out=str(tmp_path))
+    with pytest.raises(ValueError, match=r"seed: must be an integer in \[0, 2\*\*64\)"):
+        actionshift.evaluate(lambda obs: np.zeros(7), seed=-1, episodes=1, out=str(tmp_path))
 
 
 def test_threads_give_the_same_job_and_copy_the_policy_per_worker(tmp_path):

@@ -31,7 +31,15 @@ def test_vector_env_equals_single_envs_and_autoresets():
 def test_vector_env_errors():
     with pytest.raises(ValueError, match="num_envs"):
         actionshift.make_vec("pick_cube", num_envs=0)
+    # a million Bullet worlds (about 0.2 MB each) would exhaust memory: refused before any is built
+    with pytest.raises(ValueError, match=f"num_envs: must be between 1 and {actionshift.MAX_NUM_ENVS}"):
+        actionshift.make_vec("pick_cube", num_envs=10 ** 6)
+    with pytest.raises(ValueError, match="threads"):
+        actionshift.make_vec("pick_cube", num_envs=2, threads=-1)
     vec = actionshift.make_vec("pick_cube", num_envs=2)
+    # stepping before the first reset used to segfault
+    with pytest.raises(RuntimeError, match=r"step: called before reset\(\)"):
+        vec.step(np.zeros((2, 7)))
     vec.reset(seed=0)
     with pytest.raises(ValueError, match=r"actions: must have shape \(2, 7\)"):
         vec.step(np.zeros((3, 7)))

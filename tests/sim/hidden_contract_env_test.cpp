@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 namespace actionshift::sim {
@@ -144,6 +145,27 @@ TEST(HiddenContractEnv, ToolFrameUsesTheLiveTcpOrientationUnlessIdentityMode) {
   flat.step(raw);
   EXPECT_TRUE(ol.decoded().back().head<3>().isApprox(r.col(0) * 0.5, 1e-12));
   EXPECT_TRUE(of.decoded().back().head<3>().isApprox(Eigen::Vector3d(0.5, 0, 0), 1e-12));
+}
+
+TEST(HiddenContractEnv, SteppingOrReadingStateBeforeTheFirstResetThrowsInsteadOfCrashing) {
+  // the Bullet world holds a robot only after a reset: these used to dereference a null robot
+  const auto model = EnvModel::make(TaskId::kPushCube);
+  HiddenContractEnv env(model, Contract::identity());
+  EXPECT_THROW(env.step(Action::Zero()), std::logic_error);
+  Env raw(model);
+  EXPECT_THROW(raw.step(Action::Zero()), std::logic_error);
+  EXPECT_THROW(raw.qpos(), std::logic_error);
+  EXPECT_THROW(raw.tcp_pose(), std::logic_error);
+  EXPECT_THROW(raw.tcp_pose_in_base(), std::logic_error);
+  EXPECT_THROW(raw.snapshot(), std::logic_error);
+  EXPECT_THROW(raw.finger_forces(), std::logic_error);
+  // after a reset all of them work
+  env.reset(3);
+  EXPECT_EQ(env.step(Action::Zero()).safety, SafetyFlag::kNone);
+  raw.reset(3);
+  EXPECT_NO_THROW(raw.snapshot());
+  EXPECT_NO_THROW(raw.finger_forces());
+  EXPECT_TRUE(raw.tcp_pose().matrix().allFinite());
 }
 
 TEST(HiddenContractEnv, RawNanSixElementAndHugeActionsEndTheEpisodeWithAFlag) {

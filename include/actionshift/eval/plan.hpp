@@ -83,11 +83,12 @@ struct JobRequest {
   std::uint64_t seed{20260718};       ///< experimental seed
   std::int64_t episodes{256};         ///< episodes
   double obs_noise{0.0};              ///< observation-noise sigma (run/render --obs-noise; 0 = off)
+  std::string source{"command line"};  ///< where the request came from, named in its errors
 };
 
 /// Resolve a request into a validated JobSpec with the same resolver `plan` uses, so a job run from
 /// the command line has the same id as the same job run from a plan.
-/// Throws actionshift::InputError from the resolver or for an invalid field (source "command line").
+/// Throws actionshift::InputError from the resolver or for an invalid field (named by `request.source`).
 JobSpec resolve_job(const JobRequest& request, const PlanResolver& resolver);
 
 /// One job of a plan.

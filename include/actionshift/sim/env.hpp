@@ -181,6 +181,8 @@ class Env {
   const StepResult& last() const;        ///< result of the last step (or of reset)
   const EpisodeStats& episode() const;   ///< statistics of the current episode
 
+  // The state accessors below read the Bullet world, which holds the robot only after the first
+  // reset: before it they (like step and abort) throw std::logic_error.
   Eigen::Isometry3d tcp_pose() const;    ///< TCP pose, world frame
   Eigen::Isometry3d tcp_pose_in_base() const;  ///< TCP pose, robot base frame (controller frame)
   TaskSnapshot snapshot() const;          ///< state the task predicates read

@@ -44,7 +44,8 @@ class HiddenContractEnv {
   /// New episode: env reset (initial state = pure function of seed) and decoder reset.
   const Eigen::VectorXd& reset(std::uint64_t seed);
   /// One control step with a raw action. Non-finite, wrong-sized or out-of-range raw actions (and
-  /// decoded actions) end the episode with a safety flag; nothing is simulated for them.
+  /// decoded actions) end the episode with a safety flag; nothing is simulated for them. Throws
+  /// std::logic_error before the first reset.
   const StepResult& step(std::span<const double> raw);
   const StepResult& step(const Action& raw);
 
