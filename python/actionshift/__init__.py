@@ -9,6 +9,7 @@ the Gymnasium-style environment classes. See docs/python.md.
     >>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 """
 import json as _json
+import os as _os
 import sys as _sys
 
 import numpy as _np
@@ -263,10 +264,28 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     if seed is None:
         raise ValueError("seed: must be an integer in [0, 2**64) (got None)")
     _check_seed(seed)
+    for name, value in (("task", task), ("split", split), ("method", method), ("rotation", rotation),
+                        ("profile", profile), ("progress", progress)):
+        if not isinstance(value, str):
+            raise TypeError(f"evaluate: {name}: expected str (got {type(value).__name__})")
+    if not isinstance(out, (str, _os.PathLike)):
+        raise TypeError(f"evaluate: out: expected a directory path (got {type(out).__name__})")
+    if backbone is not None and not isinstance(backbone, str):
+        raise TypeError(f"evaluate: backbone: expected str or None (got {type(backbone).__name__})")
+    if pool is not None and not isinstance(pool, (str, _os.PathLike)):
+        raise TypeError(f"evaluate: pool: expected a pool name or manifest path (a job records its pool by name and "
+                        f"hash; got {type(pool).__name__})")
+    for name, value, lo, hi, why in (("episodes", episodes, 1, 2 ** 62, "must be > 0 and at most 2**62"),
+                                     ("threads", threads, 0, 4096, "must be 0 (all cores) or a count up to 4096")):
+        if not isinstance(value, (int, _np.integer)) or isinstance(value, bool):
+            raise TypeError(f"evaluate: {name}: expected int (got {type(value).__name__})")
+        if not lo <= value <= hi:
+            raise ValueError(f"evaluate: {name}: {why} (got {value})")
     if backbone is None:
         target = policy if hasattr(policy, "__qualname__") else type(policy)
         backbone = f"python:{getattr(target, '__module__', '?')}.{target.__qualname__}"
-    return _native._evaluate(policy, task, split, method, int(seed), int(episodes), str(out), backbone, pool,
+    return _native._evaluate(policy, task, split, method, int(seed), int(episodes), _os.fspath(out), backbone,
+                             None if pool is None else _os.fspath(pool),
                              params, rotation, profile, progress, int(threads))
 
 

@@ -37,6 +37,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -128,13 +129,29 @@ DArray mat_out(const Mat3& R) {
 }
 
 py::object json_to_py(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
-std::string py_to_json(py::handle h) { return py::module_::import("json").attr("dumps")(h).cast<std::string>(); }
+// JSON text of a Python value (a dict of params, a contract, a job spec), with one-line errors for
+// what JSON cannot hold: NaN and infinity (which json.dumps would write as bare NaN), objects that
+// are not numbers, strings, lists or dicts, and nesting deeper than Python's recursion limit
+std::string py_to_json(py::handle h, const char* what = "value") {
+  try {
+    return py::module_::import("json").attr("dumps")(h, py::arg("allow_nan") = false).cast<std::string>();
+  } catch (py::error_already_set& e) {
+    std::string why;
+    if (e.matches(PyExc_ValueError)) why = "NaN and infinity are not allowed (JSON has no such numbers)";
+    else if (e.matches(PyExc_TypeError)) why = "holds a value JSON cannot represent (" + std::string(py::str(e.value())) + ")";
+    else if (e.matches(PyExc_RecursionError)) why = "nested too deeply";
+    else throw;
+    value_error(std::string(what) + ": " + why);
+  }
+}
 
 Contract contract_from_text(const std::string& text) {
   try {
     return Contract::from_json(text);
   } catch (const std::invalid_argument& e) {
-    throw InputError("contract", "", e.what());
+    std::string why = e.what();
+    if (why.rfind("contract: ", 0) == 0) why.erase(0, 10);  // the parser's own prefix: name it once
+    throw InputError("contract", "", why);
   }
 }
 
@@ -142,12 +159,15 @@ Contract contract_from_text(const std::string& text) {
 Contract to_contract(py::handle h) {
   if (py::isinstance<Contract>(h)) return h.cast<Contract>();
   if (py::isinstance<py::str>(h)) return contract_from_text(h.cast<std::string>());
-  if (py::isinstance<py::dict>(h)) return contract_from_text(py_to_json(h));
+  if (py::isinstance<py::dict>(h)) return contract_from_text(py_to_json(h, "contract"));
   throw py::type_error("contract: expected an actionshift.Contract, its JSON text or a dict");
 }
 
 std::vector<Contract> to_contracts(py::handle h, const char* what) {
   if (py::isinstance<py::str>(h)) return data::resolve_manifest(h.cast<std::string>()).contracts();
+  if (py::isinstance<py::dict>(h) || !py::isinstance<py::iterable>(h))
+    throw py::type_error(std::string(what) + ": expected a pool name, a manifest path or a list of contracts (got " +
+                         Py_TYPE(h.ptr())->tp_name + ")");
   std::vector<Contract> out;
   for (py::handle x : h) out.push_back(to_contract(x));
   if (out.empty()) value_error(std::string(what) + ": must not be empty");
@@ -231,6 +251,24 @@ std::uint64_t to_seed(py::handle h, const char* what) {
   const unsigned long long v = PyLong_AsUnsignedLongLong(index.ptr());
   if (PyErr_Occurred()) fail();
   return static_cast<std::uint64_t>(v);
+}
+
+// an integer argument from Python in [lo, hi], else a one-line ValueError
+std::int64_t to_int(py::handle h, const char* what, std::int64_t lo, std::int64_t hi) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const auto fail = [&] {
+    PyErr_Clear();
+    std::string got = py::repr(h);
+    if (got.size() > 40 || got.find('\n') != std::string::npos) got = std::string("a ") + Py_TYPE(h.ptr())->tp_name;
+    value_error(std::string(what) + ": must be an integer in " + range + " (got " + got + ")");
+  };
+  if (py::isinstance<py::bool_>(h)) fail();
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr()));
+  if (!index) fail();
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || PyErr_Occurred() || v < lo || v > hi) fail();
+  return v;
 }
 
 std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
@@ -607,7 +645,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.task = task;
   q.split = split;
   q.method.name = method;
-  q.method.params = params.is_none() ? "{}" : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params));
+  q.method.params = params.is_none() ? "{}" : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
   q.backbone = backbone;
   q.pool = pool;
   q.rotation_mode = rotation;
@@ -685,7 +723,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
                                              py::object truth, py::object params) {
   const std::string text =
-      params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params));
+      params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
   const nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);
   if (parsed.is_discarded() || !parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
   const nlohmann::json p = adapt::resolve_method_params(method, parsed);
@@ -710,14 +748,29 @@ std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const st
   return adapt::make_adapter(method, p, in);  // adapters copy what they keep
 }
 
-adapt::TcpSlice slice_of(const std::string& task) {
-  return eval::tcp_slice(sim::observation_layout(sim::parse_task(task)));
+// where a task's observation holds the TCP pose, and the observation's length
+struct ObsSlice {
+  adapt::TcpSlice tcp;
+  py::ssize_t size;
+};
+
+ObsSlice slice_of(const std::string& task) {
+  const sim::ObservationLayout& layout = sim::observation_layout(sim::parse_task(task));
+  return {eval::tcp_slice(layout), static_cast<py::ssize_t>(layout.size())};
 }
 
-std::vector<double> obs_vector(py::handle h, const adapt::TcpSlice& s, const char* what) {
+// an observation of exactly the task's length: another task's observation (or any other vector)
+// would be read at the wrong offsets without complaint
+std::vector<double> obs_vector(py::handle h, const ObsSlice& s, const std::string& task, const char* what) {
   DArray a = as_array(h, what);
-  if (a.ndim() != 1 || a.shape(0) < s.quaternion_start + 4)
-    value_error(std::string(what) + ": not an observation of this task (got shape " + shape_of(a) + ")");
+  if (a.ndim() != 1 || a.shape(0) != s.size)
+    value_error(std::string(what) + ": not an observation of " + task + " (expected shape (" + std::to_string(s.size) +
+                ",), got " + shape_of(a) + ")");
+  if (!std::all_of(a.data(), a.data() + a.shape(0), [](double x) { return std::isfinite(x); }))
+    value_error(std::string(what) + ": must be finite");
+  const double* q = a.data() + s.tcp.quaternion_start;
+  if (std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) < 1e-9)
+    value_error(std::string(what) + ": its TCP quaternion is zero");
   return {a.data(), a.data() + a.shape(0)};
 }
 
@@ -744,6 +797,8 @@ class PySelfTest {
       if (py::isinstance<py::str>(model)) {
         o.model = eval::builtin_selftest_calibration(model.cast<std::string>()).model();
       } else {
+        if (!py::isinstance<py::dict>(model) || !model.contains("alpha") || !model.contains("sigma"))
+          throw py::type_error("model: expected a calibration name or a dict with 'alpha' and 'sigma' (6 numbers each)");
         const auto alpha = to_vec<kPoseDim>(model["alpha"], "model.alpha");
         const auto sigma = to_vec<kPoseDim>(model["sigma"], "model.sigma");
         std::copy(alpha.data(), alpha.data() + kPoseDim, o.model.alpha.begin());
@@ -883,7 +938,10 @@ PYBIND11_MODULE(_native, m) {
         py::arg("contracts"));
 
   py::class_<Decoder>(m, "Decoder", "Stateful decoder (tracked target + lag FIFO) over num_envs environments.")
-      .def(py::init([](py::handle c, int num_envs) { return Decoder(to_contract(c), num_envs); }), py::arg("contract"),
+      .def(py::init([](py::handle c, py::handle num_envs) {
+             const auto n = to_int(num_envs, "num_envs", 1, std::numeric_limits<int>::max());
+             return Decoder(to_contract(c), static_cast<int>(n));
+           }), py::arg("contract"),
            py::arg("num_envs") = 1)
       .def_property_readonly("contract", &Decoder::contract)
       .def_property_readonly("num_envs", &Decoder::num_envs)
@@ -1006,7 +1064,9 @@ PYBIND11_MODULE(_native, m) {
       .def("begin_episode", [](adapt::Adapter& a, py::handle seed) { a.begin_episode(to_seed(seed, "episode_seed")); },
            py::arg("episode_seed"))
       .def("encode", [](adapt::Adapter& a, py::handle canonical, py::handle R) {
-             return vec_out(a.encode(to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R")));
+             const Action c = to_vec<kActionDim>(canonical, "canonical");
+             if (!c.allFinite()) value_error("canonical: must be finite (it holds NaN or inf)");
+             return vec_out(a.encode(c, to_rotation(R, "R")));
            }, py::arg("canonical"), py::arg("R") = py::none())
       .def("observe", [](adapt::Adapter& a, py::handle raw, py::handle response, py::handle R) {
              a.observe(to_vec<kActionDim>(raw, "raw"), to_vec<kPoseDim>(response, "response"), to_rotation(R, "R"));
@@ -1019,22 +1079,22 @@ PYBIND11_MODULE(_native, m) {
   m.def("method_needs_pool", &adapt::method_needs_pool, py::arg("method"));
   m.def("method_needs_calibration", &adapt::method_needs_calibration, py::arg("method"));
   m.def("method_params", [](const std::string& method, py::object params) {
-        return json_to_py(eval::resolved_method_params(method, params.is_none() ? "{}" : py_to_json(params)));
+        return json_to_py(eval::resolved_method_params(method, params.is_none() ? "{}" : py_to_json(params, "params")));
       }, py::arg("method"), py::arg("params") = py::none(), "The method's parameters with every default filled in.");
   m.def("tcp_rotation", [](py::handle obs, const std::string& task) {
         const auto s = slice_of(task);
-        return mat_out(adapt::tcp_rotation(obs_vector(obs, s, "obs"), s));
+        return mat_out(adapt::tcp_rotation(obs_vector(obs, s, task, "obs"), s.tcp));
       }, py::arg("obs"), py::arg("task"), "The TCP orientation in an observation (the R adapters take under `live`).");
   m.def("tcp_response", [](py::handle prev, py::handle cur, const std::string& task) {
         const auto s = slice_of(task);
-        return vec_out(adapt::tcp_response(obs_vector(prev, s, "prev_obs"), obs_vector(cur, s, "obs"), s));
+        return vec_out(adapt::tcp_response(obs_vector(prev, s, task, "prev_obs"), obs_vector(cur, s, task, "obs"), s.tcp));
       }, py::arg("prev_obs"), py::arg("obs"), py::arg("task"), "The TCP response (6) between two observations.");
 
   // ---- evaluation
   m.def("_evaluate", &evaluate, py::arg("policy"), py::arg("task"), py::arg("split"), py::arg("method"), py::arg("seed"),
         py::arg("episodes"), py::arg("out"), py::arg("backbone"), py::arg("pool"), py::arg("params"),
         py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"));
-  m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec)), "job")); },
+  m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec, "job")), "job")); },
         py::arg("job"));
 
   // ---- self-test

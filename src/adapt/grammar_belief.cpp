@@ -234,7 +234,8 @@ Action GrammarBelief::map_encode(const Action& canonical, bool accumulate) {
   } else {
     raw = actionshift::encode(map().contract, canonical, Mat3::Identity(), target_);
   }
-  if (accumulate) target_ += canonical.head<kPoseDim>();
+  // a non-finite intent (which the env refuses) must not poison the tracked target for the rest of the episode
+  if (accumulate && canonical.head<kPoseDim>().allFinite()) target_ += canonical.head<kPoseDim>();
   return raw;
 }
 

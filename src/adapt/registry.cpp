@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <string>
 
 namespace actionshift::adapt {
@@ -85,6 +87,13 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
     const bool ok = (d.is_string() && v.is_string()) || (d.is_boolean() && v.is_boolean()) || (d.is_number_integer() && v.is_number_integer()) ||
                     (d.is_number_float() && v.is_number());
     if (!ok) throw InputError("method " + method, it.key(), "wrong type (expected like " + d.dump() + ")");
+    // every integer parameter is an int inside the adapters: a larger number would wrap around
+    // (2**32 + 3 became 3) while the job recorded the number as given
+    if (d.is_number_integer() &&
+        (v.is_number_unsigned() ? v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+                                : (v.get<std::int64_t>() > std::numeric_limits<int>::max() ||
+                                   v.get<std::int64_t>() < std::numeric_limits<int>::min())))
+      throw InputError("method " + method, it.key(), "out of range (got " + v.dump() + ")");
     out[it.key()] = d.is_number_float() ? nlohmann::json(v.get<double>()) : v;
   }
   if (out.contains("budget") && (out["budget"].get<int>() < 0 || out["budget"].get<int>() > 1000))
@@ -93,13 +102,15 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
     const double a = out["amplitude"].get<double>();
     if (!(a > 0.0 && a <= 1.0)) throw InputError("method " + method, "amplitude", "must be in (0, 1]");
   }
-  if (out.contains("max_active") && out["max_active"].get<int>() < 1)
-    throw InputError("method " + method, "max_active", "must be at least 1");
+  if (out.contains("max_active") && (out["max_active"].get<int>() < 1 || out["max_active"].get<int>() > 100000))
+    throw InputError("method " + method, "max_active", "must be in [1, 100000]");
   if (out.contains("tau") && !(out["tau"].get<double>() >= 0.0 && std::isfinite(out["tau"].get<double>())))
     throw InputError("method " + method, "tau", "must be finite and nonnegative");
   if (out.contains("entropy_tolerance") && !(out["entropy_tolerance"].get<double>() >= 0.0))
     throw InputError("method " + method, "entropy_tolerance", "must be nonnegative");
-  if (out.contains("window") && out["window"].get<int>() < 1) throw InputError("method " + method, "window", "must be at least 1");
+  // DualABI's window holds one slot per step per pool member: bounded so a typo cannot allocate gigabytes
+  if (out.contains("window") && (out["window"].get<int>() < 1 || out["window"].get<int>() > 1000))
+    throw InputError("method " + method, "window", "must be in [1, 1000]");
   auto one_of = [&](const char* key, std::initializer_list<const char*> allowed) {
     if (!out.contains(key)) return;
     const auto v = out[key].get<std::string>();

@@ -42,6 +42,12 @@ bool check_pose(const TcpPose& p, const char* what, std::string* err) {
     if (err) *err = std::string("selftest: ") + what + ": finger positions must be finite";
     return false;
   }
+  // metres: a pose beyond this is a unit or wiring error, and its squares would overflow the belief
+  constexpr double kMaxCoordinate = 1e6;
+  if (p.position.cwiseAbs().maxCoeff() > kMaxCoordinate || (p.fingers && p.fingers->cwiseAbs().maxCoeff() > kMaxCoordinate)) {
+    if (err) *err = std::string("selftest: ") + what + ": TCP or finger position beyond 1e6 m (check the units)";
+    return false;
+  }
   return true;
 }
 
@@ -340,6 +346,11 @@ Verdict SelfTest::verdict() const {
   if (s.raws.empty() && v.status != Status::kInconclusive) {  // e.g. a one-member pool: never pass without evidence
     v.status = Status::kInconclusive;
     v.reason = "no probe responses observed. Abstaining.";
+  }
+  // never a verdict from numbers that overflowed (the inputs are bounded, so this is a last guard)
+  if (!impl_->belief.probs().allFinite() || !std::isfinite(e.fit_ratio)) {
+    v.status = Status::kInconclusive;
+    v.reason = "the posterior or the fit is not finite (the observed responses are out of range). Abstaining.";
   }
   return v;
 }

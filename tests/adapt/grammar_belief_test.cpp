@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -285,6 +286,31 @@ TEST(GrammarParams, DefaultsAndMalformed) {
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"budget", -1}}), InputError);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"amplitude", std::nan("")}}), InputError);
   EXPECT_THROW(resolve_method_params("grammar_belief", {{"after_probe", "nothing"}}), InputError);
+}
+
+TEST(MethodParams, IntegersBeyondAnIntAreRejectedNotWrappedAndSizesAreBounded) {
+  // 2**32 + 3 used to pass the [0, 1000] check as 3 while the job recorded 4294967299
+  for (const char* m : {"fixed_probes", "grammar_belief"}) {
+    EXPECT_THROW(resolve_method_params(m, {{"budget", 4294967299ULL}}), InputError) << m;
+    EXPECT_THROW(resolve_method_params(m, {{"budget", std::int64_t{-4294967296}}}), InputError) << m;
+  }
+  EXPECT_THROW(resolve_method_params("grammar_belief", {{"hold_rounds", 4294967297LL}}), InputError);
+  EXPECT_THROW(resolve_method_params("osi", {{"warmup", 4294967304LL}}), InputError);
+  // DualABI's window and the active set are bounded: 10**7 took 5.8 GB to build
+  EXPECT_THROW(resolve_method_params("dualabi", {{"window", 10000000}}), InputError);
+  EXPECT_EQ(resolve_method_params("dualabi", {{"window", 1000}})["window"], 1000);
+  EXPECT_THROW(resolve_method_params("entropy_probes", {{"max_active", 1 << 20}}), InputError);
+  EXPECT_EQ(resolve_method_params("fixed_probes", {{"budget", 1000}})["budget"], 1000);
+}
+
+TEST(GrammarBelief, ANonFiniteIntentDoesNotPoisonTheTrackedTarget) {
+  const ResponseModel m = pick_like();
+  MethodInputs in;
+  in.model = &m;
+  const auto a = make_adapter("grammar_belief", resolve_method_params("grammar_belief"), in);
+  a->begin_episode(1);
+  a->encode(Action::Constant(std::numeric_limits<double>::quiet_NaN()), Mat3::Identity());
+  for (int s = 0; s < 5; ++s) EXPECT_TRUE(a->encode(intent(s), Mat3::Identity()).allFinite()) << "step " << s;
 }
 
 

@@ -148,4 +148,13 @@ TEST(Decoder, RejectsBadShapes) {
 }
 
 }  // namespace
+TEST(Decoder, RefusesASizeWhoseStateWouldTakeAGigabyte) {
+  // num_envs x (lag + 1) slots of 7 doubles: 10**5 environments at lag 1024 would touch 5.6 GB
+  EXPECT_THROW(Decoder(Contract::identity(), (1 << 24) + 1), std::invalid_argument);
+  ContractFields f = Contract::identity().fields();
+  f.lag = 1024;
+  EXPECT_THROW(Decoder(Contract::make(f), 100000), std::invalid_argument);
+  EXPECT_NO_THROW(Decoder(Contract::make(f), 1000));
+}
+
 }  // namespace actionshift

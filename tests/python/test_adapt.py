@@ -85,4 +85,15 @@ def test_adapter_errors_are_value_errors():
     a = actionshift.make_adapter("no_adapt", task=TASK)
     with pytest.raises(ValueError, match="canonical: must be 7 numbers"):
         a.encode([1, 2], None)
+    with pytest.raises(ValueError, match=r"canonical: must be finite"):
+        a.encode(np.full(7, np.nan), None)
+    # what JSON cannot hold, and integers the adapters' ints cannot (2**32 + 3 used to run as 3)
+    with pytest.raises(ValueError, match=r"^params: NaN and infinity are not allowed"):
+        actionshift.make_adapter("dualabi", task=TASK, pool="reference9", params={"tau": float("nan")})
+    with pytest.raises(ValueError, match=r"budget: out of range \(got 4294967299\)"):
+        actionshift.make_adapter("fixed_probes", task=TASK, pool="reference9", params={"budget": 2 ** 32 + 3})
+    with pytest.raises(ValueError, match=r"window: must be in \[1, 1000\]"):
+        actionshift.make_adapter("dualabi", task=TASK, pool="reference9", params={"window": 10 ** 7})
+    with pytest.raises(TypeError, match="pool: expected a pool name, a manifest path or a list of contracts"):
+        actionshift.make_adapter("exact_belief", task=TASK, pool=5)
     assert actionshift.method_params("entropy_probes")["budget"] == 6

@@ -123,3 +123,29 @@ def test_decoder_batch_input_that_is_not_numbers_is_a_value_error(raw):
         d.step_batch(np.zeros((2, 7)), R="x")
     with pytest.raises(ValueError, match="reset_mask: must be 2 booleans"):
         d.step_batch(np.zeros((2, 7)), reset_mask=object())
+
+
+def test_tcp_slices_need_an_observation_of_exactly_that_task():
+    # a peg observation (43 numbers) read as pick_cube's (42) used to give a plausible wrong rotation
+    obs = actionshift.make("peg_insertion_side").reset(seed=1)[0]
+    assert actionshift.tcp_rotation(obs, "peg_insertion_side").shape == (3, 3)
+    with pytest.raises(ValueError, match=r"obs: not an observation of pick_cube \(expected shape \(42,\)"):
+        actionshift.tcp_rotation(obs, "pick_cube")
+    with pytest.raises(ValueError, match="its TCP quaternion is zero"):
+        actionshift.tcp_rotation(np.zeros(obs.shape), "peg_insertion_side")
+    with pytest.raises(ValueError, match="prev_obs: must be finite"):
+        actionshift.tcp_response(np.full(obs.shape, np.nan), obs, "peg_insertion_side")
+
+
+def test_decoder_sizes_and_contract_dict_errors_are_one_line():
+    with pytest.raises(ValueError, match=r"num_envs x \(lag \+ 1\) must be at most 16777216"):
+        actionshift.Decoder(actionshift.Contract(lag=1024), num_envs=10 ** 5)
+    with pytest.raises(ValueError, match=r"num_envs: must be an integer in \[1, "):
+        actionshift.Decoder(actionshift.Contract(), num_envs=2 ** 40)
+    bad = {"frame": "base", "gripper_inverted": False, "lag": 0, "permutation": [0, 1, 2, 3, 4, 5],
+           "scale": [float("nan")] + [1.0] * 5, "sign": [1] * 6, "target": "delta"}
+    with pytest.raises(ValueError, match=r"^contract: NaN and infinity are not allowed"):
+        actionshift.make("pick_cube", contract=bad)
+    with pytest.raises(ValueError) as e:
+        actionshift.Contract.from_json("{")
+    assert not str(e.value).startswith("contract: contract:")

@@ -67,8 +67,23 @@ def test_evaluate_errors(tmp_path, cli):
     with pytest.raises(ValueError, match="profile"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), profile="no_such_profile")
     # a job's field errors name evaluate(), not the command line
-    with pytest.raises(ValueError, match=r"^evaluate: episodes: must be > 0 \(got 0\)$"):
+    with pytest.raises(ValueError, match=r"^evaluate: episodes: must be > 0 and at most 2\*\*62 \(got 0\)$"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=0, out=str(tmp_path))
+    # argument types: one-line errors, and nothing written (out=None used to write to ./None)
+    for kwargs, error, pattern in (({"out": None}, TypeError, "evaluate: out: expected a directory path"),
+                                   ({"split": None}, TypeError, "evaluate: split: expected str"),
+                                   ({"pool": [actionshift.Contract.identity()]}, TypeError, "evaluate: pool: expected a pool name"),
+                                   ({"episodes": 2.5}, TypeError, "evaluate: episodes: expected int"),
+                                   ({"episodes": 2 ** 63}, ValueError, "evaluate: episodes: must be > 0"),
+                                   ({"threads": 2 ** 40}, ValueError, "evaluate: threads: must be 0")):
+        args = {"episodes": 1, "out": str(tmp_path / "typed"), **kwargs}
+        with pytest.raises(error, match=pattern) as e:
+            actionshift.evaluate(lambda obs: np.zeros(7), **args)
+        assert "\n" not in str(e.value)
+    assert not (tmp_path / "typed").exists()
+    # a job's field errors that only the library checks name evaluate(), not the command line
+    with pytest.raises(ValueError, match=r"^evaluate: rotation_mode: "):
+        actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), rotation="sideways")
     with pytest.raises(ValueError, match=r"seed: must be an integer in \[0, 2\*\*64\)"):
         actionshift.evaluate(lambda obs: np.zeros(7), seed=-1, episodes=1, out=str(tmp_path))
 

@@ -58,3 +58,16 @@ def test_selftest_misuse_raises():
         st.next_probe()  # begin() was not called (std::logic_error)
     with pytest.raises(ValueError):
         st.begin([0, 0, 0], [0, 0, 0, 0])  # zero quaternion
+
+
+def test_selftest_option_and_pose_errors_name_the_argument():
+    with pytest.raises(TypeError, match="pool: expected a pool name"):
+        actionshift.SelfTest(pool=5)
+    with pytest.raises(TypeError, match="model: expected a calibration name or a dict with 'alpha' and 'sigma'"):
+        actionshift.SelfTest(model={"alpha": [1.0] * 6})
+    st = actionshift.SelfTest()
+    st.begin([0.3, 0.0, 0.2], [1.0, 0.0, 0.0, 0.0])
+    assert st.next_probe() is not None
+    # finite but absurd positions used to turn the posterior into NaN behind an ordinary verdict
+    with pytest.raises(ValueError, match="beyond 1e6 m"):
+        st.observe([1e200, 0.0, 0.2], [1.0, 0.0, 0.0, 0.0])

@@ -340,6 +340,15 @@ TEST(SelfTest, MisuseIsReportedNotIgnored) {
   EXPECT_FALSE(st.try_observe(zero_q, &err));
   EXPECT_THAT(err, HasSubstr("quaternion must be non-zero"));
   EXPECT_EQ(st.probes_observed(), 0) << "a rejected sample is not evidence";
+  // finite but absurd (a unit error): its squares used to overflow the belief into NaN confidences
+  TcpPose far;
+  far.position[0] = 1e200;
+  EXPECT_FALSE(st.try_observe(far, &err));
+  EXPECT_THAT(err, HasSubstr("beyond 1e6 m"));
+  TcpPose far_fingers;
+  far_fingers.fingers = Eigen::Vector2d(0.04, 1e9);
+  EXPECT_FALSE(st.try_observe(far_fingers, &err));
+  EXPECT_EQ(st.probes_observed(), 0);
   EXPECT_TRUE(st.try_observe({}, &err));
   EXPECT_EQ(st.probes_observed(), 1);
 }

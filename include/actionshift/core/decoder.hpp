@@ -8,12 +8,16 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace actionshift {
+
+/// Largest num_envs x (lag + 1) a Decoder accepts: each slot holds 7 doubles, so this is about 0.9 GB.
+inline constexpr std::int64_t kMaxDecoderSlots = std::int64_t{1} << 24;
 
 /// Per-environment decoder state for one contract (the Data to the Contract's Model).
 ///
@@ -25,10 +29,14 @@ class Decoder {
  public:
   using Batch = Eigen::Matrix<double, kActionDim, Eigen::Dynamic>;  ///< 7 × N, one column per env
 
-  /// Throws std::invalid_argument if num_envs < 1.
+  /// Throws std::invalid_argument if num_envs < 1 or num_envs x (lag + 1) > kMaxDecoderSlots.
   explicit Decoder(const Contract& c, int num_envs = 1)
       : contract_(c), num_envs_(num_envs) {
     if (num_envs < 1) throw std::invalid_argument("decoder needs at least one environment (got " + std::to_string(num_envs) + ")");
+    if (static_cast<std::int64_t>(num_envs) * (c.lag() + 1) > kMaxDecoderSlots)
+      throw std::invalid_argument("decoder: num_envs x (lag + 1) must be at most " + std::to_string(kMaxDecoderSlots) +
+                                  " (got " + std::to_string(num_envs) + " x " + std::to_string(c.lag() + 1) +
+                                  "): its targets and lag FIFOs would take about 1 GB or more");
     targets_ = Eigen::Matrix<double, kPoseDim, Eigen::Dynamic>::Zero(kPoseDim, num_envs);
     history_ = Batch::Zero(kActionDim, static_cast<Eigen::Index>(c.lag()) * num_envs);
   }
