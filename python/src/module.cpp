@@ -791,8 +791,21 @@ class PySelfTest {
              const std::string& task, py::object gripper)
       : task_(task) {
     selftest::Options o;
-    if (!expected.is_none()) o.expected = to_contract(expected);
-    if (!pool.is_none()) o.pool = to_contracts(pool, "pool");
+    // as on the command line: a library contract by name ("swapped-axes"), and "library" for the library pool
+    if (py::isinstance<py::str>(expected)) {
+      const std::string text = expected.cast<std::string>();
+      if (const auto named = selftest::named_contract(text)) o.expected = *named;
+      else if (text.find('{') == std::string::npos)
+        throw InputError("expected", "", "unknown library contract '" + text + "' (known: " + selftest::named_contract_list() + ")");
+      else o.expected = to_contract(expected);
+    } else if (!expected.is_none()) {
+      o.expected = to_contract(expected);
+    }
+    if (py::isinstance<py::str>(pool) && pool.cast<std::string>() == "library") {
+      for (const auto& n : selftest::library()) o.pool.push_back(n.contract);
+    } else if (!pool.is_none()) {
+      o.pool = to_contracts(pool, "pool");
+    }
     if (!model.is_none()) {
       if (py::isinstance<py::str>(model)) {
         o.model = eval::builtin_selftest_calibration(model.cast<std::string>()).model();

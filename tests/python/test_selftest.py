@@ -71,3 +71,12 @@ def test_selftest_option_and_pose_errors_name_the_argument():
     # finite but absurd positions used to turn the posterior into NaN behind an ordinary verdict
     with pytest.raises(ValueError, match="beyond 1e6 m"):
         st.observe([1e200, 0.0, 0.2], [1.0, 0.0, 0.0, 0.0])
+
+
+def test_library_names_work_as_on_the_command_line():
+    lib = dict(actionshift.selftest_library())
+    st = actionshift.SelfTest(expected="swapped-axes", pool="library")
+    assert st.pool == actionshift.SelfTest().pool and len(st.pool) == len(lib)
+    assert actionshift.SelfTest(expected="swapped-axes").verdict()["expected_contract"] == lib["swapped-axes"].to_dict()
+    with pytest.raises(ValueError, match="unknown library contract 'swaped-axes'"):
+        actionshift.SelfTest(expected="swaped-axes")
