@@ -1,6 +1,7 @@
 // validate, contract hash/decode/encode, splits generate.
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/splits.hpp"
 #include "actionshift/core/transforms.hpp"
@@ -21,6 +22,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string read_file(const std::string& path) {
+  require_regular_file(path, "an input file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open file");
   std::stringstream ss;

@@ -3,6 +3,7 @@
 #include "commands.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/gates.hpp"
 #include "actionshift/eval/plan.hpp"
@@ -14,7 +15,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -41,6 +44,7 @@ int guarded(std::ostream& err, F&& body) {
 }
 
 json read_json_file(const std::string& path) {
+  require_regular_file(path, "a JSON file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open file");
   std::stringstream ss;
@@ -316,6 +320,14 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
       if (!o.mem.empty() && !eval::valid_slurm_mem(o.mem))
         throw InputError("--mem", o.mem, "not a Slurm memory size (a positive integer with an optional K, M, G or T)");
       if (o.cpus_per_task == 0) throw InputError("--cpus-per-task", "0", "must be at least 1");
+      if (o.cpus_per_task > 4096) throw InputError("--cpus-per-task", std::to_string(o.cpus_per_task), "must be at most 4096");
+      // the partition is written into the scripts: a newline or shell character there would be a command
+      const bool partition_ok =
+          o.partition.size() <= 256 && std::all_of(o.partition.begin(), o.partition.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == ',';
+          });
+      if (!partition_ok)
+        throw InputError("--partition", o.partition, "not a Slurm partition list (letters, digits, _ - . and commas)");
     }
     const std::string executable = o.slurm ? resolve_executable(o.executable) : std::string();
     const std::string plan_path =

@@ -2,6 +2,7 @@
 #include "cmd_run.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/eval/calibrate.hpp"
 #include "actionshift/eval/experiment.hpp"
 #include "actionshift/sim/task.hpp"
@@ -54,6 +55,7 @@ void check_obs_noise(double sigma) {
 
 // --calibration FILE: a response calibration JSON (as `calibrate --out` writes)
 adapt::ResponseCalibration load_calibration_file(const std::string& path) {
+  require_regular_file(path, "a calibration file");
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
   if (!in || !std::filesystem::is_regular_file(path, ec)) throw InputError(path, "--calibration", "cannot read file");

@@ -4,14 +4,15 @@
 
 #include "actionshift/adapt/calibration.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/synthetic_robot.hpp"
 #include "actionshift/sim/controller.hpp"
-#include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/robot_source.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -38,6 +39,7 @@ namespace actionshift::cli {
 namespace {
 
 std::string read_text(const std::string& path) {
+  require_regular_file(path, "a file");
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();

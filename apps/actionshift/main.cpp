@@ -15,12 +15,36 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <functional>
 #include <iostream>
 #include <string_view>
 
 using namespace actionshift;
+
+namespace {
+
+// CLI11 parses "-1" into an unsigned option as 2**64 - 1 and saturates 2**64: seeds are checked as text
+const CLI::Validator kSeed(
+    [](std::string& s) -> std::string {
+      const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
+      return "must be an integer in [0, 2**64) (got '" + s + "')";
+    },
+    "SEED");
+
+// CLI::Range lets NaN through (every comparison with it is false)
+const CLI::Validator kNotNan(
+    [](std::string& s) -> std::string {
+      const double v = std::strtod(s.c_str(), nullptr);
+      return std::isnan(v) ? "must be a number (got '" + s + "')" : std::string();
+    },
+    "");
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -36,7 +60,8 @@ int main(int argc, char** argv) {
   const auto add_robot_options = [](CLI::App* cmd, cli::RobotOptions& r) {
     cmd->add_option("--robot", r.urdf,
                     "Robot description (URDF; meshes through assimp) instead of the embedded Panda; its content hash\n"
-                    "(URDF + collision meshes) enters the job id");
+                    "(URDF + collision meshes) enters the job id")
+        ->check(CLI::Validator([](std::string& v) { return v.empty() ? std::string("must name a URDF file") : std::string(); }, ""));
     cmd->add_option("--package", r.packages, "NAME=DIR: resolve package://NAME/... in --robot (repeatable)");
   };
 
@@ -80,7 +105,7 @@ int main(int argc, char** argv) {
   cli::SplitsGenerateOptions gen_o;
   auto* gen = splits->add_subcommand("generate", "Write the manifests of the seeded rules (docs/splits.md) to a directory");
   gen->add_option("--out", gen_o.out_dir, "Output directory")->capture_default_str();
-  gen->add_option("--seed", gen_o.seed, "Generator seed")->capture_default_str();
+  gen->add_option("--seed", gen_o.seed, "Generator seed")->check(kSeed)->capture_default_str();
   gen->add_option("--rule", gen_o.rules, "Only these rules (repeatable; default: all)");
   gen->callback([&] { action = [&] { return cli::run_splits_generate(gen_o); }; });
 
@@ -96,6 +121,7 @@ int main(int argc, char** argv) {
   bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
   bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
   bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
   bench_env->add_flag("--raw-bullet", bench_env_o.raw_bullet,
@@ -127,7 +153,7 @@ int main(int argc, char** argv) {
   bench_adapt->add_option("--repetitions", bench_adapt_o.repetitions, "Repetitions (the figures are their medians)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  bench_adapt->add_option("--seed", bench_adapt_o.seed, "Seed of the synthetic episodes")->capture_default_str();
+  bench_adapt->add_option("--seed", bench_adapt_o.seed, "Seed of the synthetic episodes")->check(kSeed)->capture_default_str();
   bench_adapt->add_flag("--json", bench_adapt_o.json, "Print one JSON object");
   bench_adapt->callback([&] { action = [&] { return cli::run_bench_adapt(bench_adapt_o); }; });
 
@@ -165,7 +191,7 @@ int main(int argc, char** argv) {
                  "--sim: measure the misspecification threshold on the simulator (every pool member as the hidden\n"
                  "wiring, 8 seeds from --seed; max fit ratio of the correctly identified runs x 1.5) and write the\n"
                  "task's entry of this JSON file (configs/selftest/sim_misspec.json, embedded at build time)");
-  st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->capture_default_str();
+  st->add_option("--seed", st_o.seed, "Seed (synthetic noise; sim episode)")->check(kSeed)->capture_default_str();
   st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
   add_robot_options(st, st_o.robot);
   st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
@@ -181,7 +207,7 @@ int main(int argc, char** argv) {
   bc->add_option("--profile", train_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")
       ->capture_default_str();
   bc->add_flag("--delay-aware", train_o.delay_aware, "Append the last 4 actions to the input; train under random lag {0,1,2,4}");
-  bc->add_option("--seed", train_o.seed, "Seed")->capture_default_str();
+  bc->add_option("--seed", train_o.seed, "Seed")->check(kSeed)->capture_default_str();
   bc->add_option("--iterations", train_o.iterations, "DAgger iterations (the first rolls out the expert)")->capture_default_str();
   bc->add_option("--episodes", train_o.episodes, "Episodes per iteration")->capture_default_str();
   bc->add_option("--steps", train_o.steps, "Adam steps per iteration")->capture_default_str();
@@ -201,7 +227,7 @@ int main(int argc, char** argv) {
       ->required();
   tid->add_option("--task", tid_o.task, "Task of the rollouts")->capture_default_str();
   tid->add_option("--profile", tid_o.profile, "Simulator fidelity profile of the rollouts")->capture_default_str();
-  tid->add_option("--seed", tid_o.seed, "Seed (weights init, rollouts, minibatches)")->capture_default_str();
+  tid->add_option("--seed", tid_o.seed, "Seed (weights init, rollouts, minibatches)")->check(kSeed)->capture_default_str();
   tid->add_option("--excitation", tid_o.excitation,
                   "expert: the scripted expert passed through (what a passive identifier sees); random: uniform raw\n"
                   "pose actions in [-0.5, 0.5] (the random-excitation ablation)")
@@ -224,7 +250,7 @@ int main(int argc, char** argv) {
              "`ppo`; checkpointed after every evaluation) and a training curve, one JSON line per iteration.");
   ppo->add_option("--task", ppo_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
   ppo->add_option("--profile", ppo_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->capture_default_str();
-  ppo->add_option("--seed", ppo_o.seed, "Seed (initialisation, episodes, exploration noise, minibatches)")->capture_default_str();
+  ppo->add_option("--seed", ppo_o.seed, "Seed (initialisation, episodes, exploration noise, minibatches)")->check(kSeed)->capture_default_str();
   ppo->add_option("--total-steps", ppo_o.total_steps, "Environment steps of the run")->capture_default_str();
   ppo->add_option("--envs", ppo_o.envs, "Parallel environments")->capture_default_str();
   ppo->add_option("--rollout-steps", ppo_o.rollout_steps, "Steps per environment per iteration")->capture_default_str();
@@ -268,14 +294,17 @@ int main(int argc, char** argv) {
   gate0->add_option("--profile", gate0_o.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")
       ->capture_default_str();
   gate0->add_option("--episodes", gate0_o.episodes, "Episodes (each run unwrapped and identity-wrapped)")->capture_default_str();
-  gate0->add_option("--seed", gate0_o.seed, "Experimental seed")->capture_default_str();
-  gate0->add_option("--floor", gate0_o.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)");
+  gate0->add_option("--seed", gate0_o.seed, "Experimental seed")->check(kSeed)->capture_default_str();
+  gate0->add_option("--floor", gate0_o.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)")
+      ->check(CLI::Range(0.0, 1.0) & kNotNan);
   gate0->add_option("--rule", gate0_o.rule, "Competence statistic: wilson_lower or point_estimate")->capture_default_str();
   gate0->add_option("--threads", gate0_o.threads, "Worker threads (0: all cores)")->capture_default_str();
   gate0->add_flag("--json", gate0_o.json, "Print the verdict file instead of text");
   gate0->add_option("--out", gate0_o.out, "Write the verdict file here");
   gate0->add_option("--backbones-dir", gate0_o.backbones_dir, "Directory of the MLP weight files");
-  gate0->add_option("--step-timeout", gate0_o.step_timeout_s, "Seconds an external policy may take per step")->capture_default_str();
+  gate0->add_option("--step-timeout", gate0_o.step_timeout_s, "Seconds an external policy may take per step")
+      ->check(CLI::Range(0.001, 86400.0) & kNotNan)
+      ->capture_default_str();
   gate0->add_option("--progress", gate0_o.progress,
                     "auto (a bar on a terminal, else lines), bar, lines or off, as for run")->capture_default_str();
   bool gate0_quiet = false;
@@ -305,7 +334,7 @@ int main(int argc, char** argv) {
   run->add_option("--method", run_o.request.method.name, "Adapter method (docs/adapters.md): " + method_list);
   run->add_option("--params", run_o.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
       ->capture_default_str();
-  run->add_option("--seed", run_o.request.seed, "Experimental seed")->capture_default_str();
+  run->add_option("--seed", run_o.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
   run->add_option("--episodes", run_o.request.episodes, "Episodes (dealt round-robin over the split's contracts)")
       ->capture_default_str();
   run->add_option("--backbone", run_o.request.backbone, "Frozen policy: expert, mlp, external:<command>, ...")
@@ -338,7 +367,7 @@ int main(int argc, char** argv) {
   run->add_option("--step-timeout", run_o.run.step_timeout_s,
                   "Seconds an external:<command> backbone may take to read one request and to reply to it\n"
                   "(a process that overruns, floods replies or dies ends the job with an error)")
-      ->check(CLI::Range(0.001, 86400.0))
+      ->check(CLI::Range(0.001, 86400.0) & kNotNan)
       ->capture_default_str();
   run->callback([&] {
     action = [&] {
@@ -396,8 +425,8 @@ int main(int argc, char** argv) {
   gate1->add_option("--results", g1_o.results_dir, "Results directory")->required();
   gate1->add_flag("--json", g1_o.json, "Print JSON");
   gate1->add_option("--verdict", g1_o.verdict_file, "Verdict file (default <results>/gate1.verdict.json)");
-  gate1->add_option("--samples", g1_o.samples, "Bootstrap resamples")->capture_default_str();
-  gate1->add_option("--bootstrap-seed", g1_o.bootstrap_seed, "Bootstrap seed")->capture_default_str();
+  gate1->add_option("--samples", g1_o.samples, "Bootstrap resamples")->check(CLI::Range(1, 1000000))->capture_default_str();
+  gate1->add_option("--bootstrap-seed", g1_o.bootstrap_seed, "Bootstrap seed")->check(kSeed)->capture_default_str();
   gate1->callback([&] { action = [&] { return cli::run_gate1(g1_o); }; });
 
   auto* gate = app.add_subcommand("gate", "Compare gate verdicts with committed expectations (CI)");
@@ -439,7 +468,7 @@ int main(int argc, char** argv) {
   calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");
   calibrate->add_option("--solver-iterations", cal_o.solver_iterations, "Ablation: Bullet solver iterations");
   calibrate->add_option("--joint-limits", cal_o.joint_limits, "Ablation: arm joint limit constraints on or off");
-  calibrate->add_option("--seed", cal_o.seed, "Seed")->capture_default_str();
+  calibrate->add_option("--seed", cal_o.seed, "Seed")->check(kSeed)->capture_default_str();
   calibrate->add_option("--obs-noise", cal_o.obs_noise,
                         "Measure under observation noise of this sigma (as run --obs-noise; off by default); the\n"
                         "calibration's profile label gets [obs_noise=S]")
@@ -464,7 +493,7 @@ int main(int argc, char** argv) {
   render->add_option("--split", render_o.request.split, "Split manifest: a built-in name or a file")->required();
   render->add_option("--method", render_o.request.method.name, "Method (as for run)")->required();
   render->add_option("--params", render_o.method_params, "Method parameters as a JSON object")->capture_default_str();
-  render->add_option("--seed", render_o.request.seed, "Experimental seed of the job")->capture_default_str();
+  render->add_option("--seed", render_o.request.seed, "Experimental seed of the job")->check(kSeed)->capture_default_str();
   render->add_option("--episodes", render_o.request.episodes, "Episodes of the job (part of its id)")->capture_default_str();
   render->add_option("--backbone", render_o.request.backbone, "Frozen policy")->capture_default_str();
   render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");

@@ -1,4 +1,5 @@
 #include "actionshift/adapt/calibration.hpp"
+#include "actionshift/core/input_file.hpp"
 
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
@@ -168,6 +169,7 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
 }
 
 ResponseCalibration ResponseCalibration::load(const std::string& path) {
+  require_regular_file(path, "a calibration file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open file");
   std::stringstream ss;

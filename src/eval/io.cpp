@@ -1,6 +1,7 @@
 #include "io.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -14,6 +15,11 @@
 namespace actionshift::eval::detail {
 
 std::string read_file(const std::string& path) {
+  require_regular_file(path, "a file");
+  std::error_code size_ec;
+  const auto size = std::filesystem::file_size(path, size_ec);
+  if (!size_ec && size > kMaxInputFileBytes)
+    throw InputError(path, "", "file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(kMaxInputFileBytes) + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", std::string("cannot open file: ") + std::strerror(errno));
   std::ostringstream ss;
@@ -23,6 +29,7 @@ std::string read_file(const std::string& path) {
 }
 
 void atomic_write(const std::string& path, std::string_view bytes) {
+  require_replaceable_output(path);
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw InputError(tmp, "", std::string("cannot create file: ") + std::strerror(errno));

@@ -1,3 +1,4 @@
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/eval/job.hpp"
 
 #include "actionshift/core/canonical_json.hpp"
@@ -86,6 +87,9 @@ void validate_job(const JobSpec& job, const std::string& src) {
   for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
   if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got " + quote_input(job.profile, '"') + ")");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
+  // a billion episodes is days of a cluster; a larger count is a typo (or a saturated parse of one)
+  if (job.episodes > kMaxJobEpisodes)
+    throw InputError(src, "episodes", "must be at most " + std::to_string(kMaxJobEpisodes) + " (got " + std::to_string(job.episodes) + ")");
   if (!(job.obs_noise >= 0.0 && job.obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
     std::ostringstream got;
     got << job.obs_noise;
@@ -232,6 +236,7 @@ std::string files_content_sha256(const std::vector<std::string>& paths, const st
   if (paths.empty()) throw InputError("", field, "name at least one file");
   std::vector<std::string> hashes;
   for (const auto& p : paths) {
+    require_regular_file(p, "a file");
     std::ifstream in(p, std::ios::binary);
     std::error_code ec;
     if (!in || !std::filesystem::is_regular_file(p, ec)) throw InputError(p, field, "cannot read file");

@@ -3,6 +3,7 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/statistics.hpp"
 #include "io.hpp"
@@ -87,6 +88,11 @@ ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, co
   // open without truncation and take the job's lock before reading anything
   s.fd_ = ::open(s.path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (s.fd_ < 0) throw InputError(s.path_, "", "cannot open results file: " + errno_text());
+  struct stat st{};
+  if (::fstat(s.fd_, &st) != 0 || !S_ISREG(st.st_mode))
+    throw InputError(s.path_, "", "not a regular file (a device, FIFO or directory cannot hold results)");
+  if (static_cast<std::uintmax_t>(st.st_size) > kMaxInputFileBytes * 4)
+    throw InputError(s.path_, "", "results file too large (" + std::to_string(st.st_size) + " bytes)");
   if (::flock(s.fd_, LOCK_EX | LOCK_NB) != 0)
     throw InputError(s.path_, "", "another process is running this job (results file is locked)");
 
@@ -130,6 +136,12 @@ ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, co
       throw InputError(src, "episode_index", "more records than the job's " + std::to_string(job.episodes) + " episodes");
     records.push_back(std::move(r));
   }
+  // a torn write loses part of one record (a line is a few hundred bytes): a longer unreadable tail
+  // is something else, and is reported rather than cut away
+  constexpr std::size_t kMaxTornTail = std::size_t{1} << 20;
+  if (bytes.size() - keep_bytes > kMaxTornTail)
+    throw InputError(s.path_, "", "the " + std::to_string(bytes.size() - keep_bytes) + " bytes after record " +
+                                      std::to_string(records.size()) + " are not records and too many for a torn write (repair or remove them)");
   if (keep_bytes < bytes.size()) {
     if (::ftruncate(s.fd_, static_cast<off_t>(keep_bytes)) != 0)
       throw InputError(s.path_, "", "cannot truncate torn last line: " + errno_text());

@@ -145,6 +145,18 @@ MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   if (w.layers.back() != kActionDim)
     throw fail("header.layers", "output size " + std::to_string(w.layers.back()) + " (expected 7)");
   const std::int64_t floats = payload_floats(w.layers);
+  // the descriptive fields must describe this file: a reader of the header alone is told the truth
+  auto expect = [&](const char* key, const nlohmann::json& want) {
+    const nlohmann::json& got = need(key);
+    if (got != want) throw fail(std::string("header.") + key, "expected " + want.dump() + " (got " + got.dump() + ")");
+  };
+  expect("version", kFormatVersion);
+  expect("activation", "tanh");
+  expect("output", "clip[-1,1]");
+  expect("obs_dim", obs_dim);
+  expect("input_dim", expected_in);
+  expect("payload_floats", floats);
+  expect("parameters", mlp_parameter_count(w.layers));
   weight_file::check_payload(u, floats, source, false, " for layers of the header");
   const std::string_view payload = u.payload;
   // read the arrays

@@ -1,4 +1,5 @@
 // images: PNG (libpng), animated GIF (giflib), the 5x7 overlay font, montages
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/render/image.hpp"
 
 #include "actionshift/core/error.hpp"
@@ -134,6 +135,7 @@ struct FileCloser {
 };
 
 std::unique_ptr<std::FILE, FileCloser> open_for_writing(const std::filesystem::path& path) {
+  require_replaceable_output(path.string());  // fopen of a FIFO would block, of /dev/full write nowhere
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "wb"));
   if (!f) throw InputError(path.string(), "out", "cannot write file");
   return f;
@@ -230,7 +232,58 @@ void write_gif(const std::filesystem::path& path, const std::vector<Image>& fram
     throw InputError(path.string(), "out", std::string("cannot finish file (") + GifErrorString(err) + ")");
 }
 
+namespace {
+
+// Walks a GIF's blocks (header, logical screen, extensions, image descriptors) before giflib decodes
+// it, and refuses a screen above kMaxGifSide or an image outside its screen: giflib sizes an image's
+// raster as a signed int width x height, which wraps at 46341 x 46341 and then writes past the
+// buffer (a 35-byte file crashed montage).
+constexpr int kMaxGifSide = 8192;
+
+void check_gif_geometry(const std::string& bytes, const std::string& path) {
+  auto fail = [&](const std::string& why) { throw InputError(path, "", "not a valid GIF (" + why + ")"); };
+  auto u16 = [&](std::size_t i) {
+    if (i + 2 > bytes.size()) fail("truncated");
+    return static_cast<int>(static_cast<unsigned char>(bytes[i])) | (static_cast<int>(static_cast<unsigned char>(bytes[i + 1])) << 8);
+  };
+  auto byte = [&](std::size_t i) {
+    if (i >= bytes.size()) fail("truncated");
+    return static_cast<unsigned char>(bytes[i]);
+  };
+  auto skip_sub_blocks = [&](std::size_t i) {
+    for (unsigned n = byte(i); n != 0; n = byte(i)) i += 1 + n;
+    return i + 1;
+  };
+  if (bytes.size() < 13 || bytes.compare(0, 3, "GIF") != 0) fail("no GIF header");
+  const int sw = u16(6), sh = u16(8);
+  if (sw > kMaxGifSide || sh > kMaxGifSide)
+    fail("screen " + std::to_string(sw) + "x" + std::to_string(sh) + " is larger than " + std::to_string(kMaxGifSide) + " pixels a side");
+  std::size_t i = 13;
+  if (byte(10) & 0x80) i += 3u * (2u << (byte(10) & 7));  // global colour table
+  for (;;) {
+    const unsigned char kind = byte(i);
+    if (kind == 0x3B) return;  // trailer
+    if (kind == 0x21) {        // extension: label, then sub-blocks
+      i = skip_sub_blocks(i + 2);
+    } else if (kind == 0x2C) {  // image descriptor
+      const int left = u16(i + 1), top = u16(i + 3), w = u16(i + 5), h = u16(i + 7);
+      if (left + w > sw || top + h > sh)
+        fail("an image of " + std::to_string(w) + "x" + std::to_string(h) + " at (" + std::to_string(left) + ", " +
+             std::to_string(top) + ") lies outside the " + std::to_string(sw) + "x" + std::to_string(sh) + " screen");
+      const unsigned char flags = byte(i + 9);
+      i += 10;
+      if (flags & 0x80) i += 3u * (2u << (flags & 7));  // local colour table
+      i = skip_sub_blocks(i + 1);                       // LZW minimum code size, then the data
+    } else {
+      fail("unknown block 0x" + std::string(1, "0123456789abcdef"[kind >> 4]) + std::string(1, "0123456789abcdef"[kind & 15]));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<Image> read_gif(const std::filesystem::path& path) {
+  check_gif_geometry(read_input_file(path.string(), "a GIF", std::uintmax_t{256} << 20), path.string());
   int err = 0;
   GifFileType* gif = DGifOpenFileName(path.c_str(), &err);
   if (!gif) throw InputError(path.string(), "", std::string("cannot read GIF (") + GifErrorString(err) + ")");

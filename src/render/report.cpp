@@ -1,4 +1,5 @@
 // the results report: HTML + Markdown with tables, verdicts, figures and provenance
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/render/report.hpp"
 #include "xml_escape.hpp"
 
@@ -31,6 +32,7 @@ std::string md(const std::string& s) {  // a Markdown table cell
 }
 
 json read_json(const fs::path& p) {
+  require_regular_file(p.string(), "a JSON file");
   std::ifstream f(p, std::ios::binary);
   if (!f) throw InputError(p.string(), "", "cannot read file");
   std::stringstream ss;

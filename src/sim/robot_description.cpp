@@ -1,4 +1,5 @@
 // urdf parsing (urdfdom) and mesh loading (assimp) into the plain RobotDescription value type
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/sim/robot_description.hpp"
 
 #include "actionshift/core/error.hpp"
@@ -168,6 +169,7 @@ class CapturingHandler final : public console_bridge::OutputHandler {
     if (first_error_.empty()) return first_;
     return last_error_ == first_error_ ? first_error_ : first_error_ + "; " + last_error_;
   }
+  bool any_error() const { return !first_error_.empty(); }
 
  private:
   std::string first_, first_error_, last_error_;
@@ -231,7 +233,9 @@ urdf::ModelInterfaceSharedPtr parse_with_reason(const std::string& xml, std::str
     fail(origin, std::string("not a valid URDF: ") + e.what());
   }
   console_bridge::restorePreviousOutputHandler();
-  if (!model || !model->getRoot()) {
+  // urdfdom can log an error and still return a model: a link whose <inertial> or <collision> it could
+  // not read (a "nan" mass, a size it cannot parse) comes back with no mass and no collisions
+  if (!model || !model->getRoot() || handler.any_error()) {
     std::string why = handler.reason();
     for (char& c : why) if (c == '\n' || c == '\r') c = ' ';
     while (!why.empty() && why.back() == ' ') why.pop_back();
@@ -464,6 +468,8 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
 }
 
 RobotDescription load_urdf_file(const std::filesystem::path& urdf, const PackageMap& packages) {
+  if (urdf.empty()) fail("--robot", "empty path (name a URDF file)");
+  require_regular_file(urdf.string(), "a URDF file");
   std::ifstream in(urdf, std::ios::binary);
   if (!in) fail(urdf.string(), "cannot open URDF file");
   std::stringstream ss;

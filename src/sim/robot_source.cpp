@@ -1,3 +1,4 @@
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/sim/robot_source.hpp"
 
 #include "actionshift/core/canonical_json.hpp"
@@ -18,6 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string read_bytes(const std::string& path, const std::string& field) {
+  require_regular_file(path, "a robot file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, field, "cannot open file");
   std::ostringstream ss;

@@ -91,6 +91,21 @@ TEST(MlpFormat, HostileHeaderNumbersAreOneLineErrors) {
   expect_input_error([] { policy::load_mlp(std::filesystem::temp_directory_path().string()); }, "is a directory");
 }
 
+TEST(MlpFormat, DescriptiveHeaderFieldsMustDescribeTheFile) {
+  // these loaded with a correct payload checksum before every field was compared with the file
+  const std::string bytes = policy::serialize_mlp(small_net(sim::TaskId::kPickCube));
+  EXPECT_NO_THROW(policy::parse_mlp(bytes, "w.asmlp"));
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"activation\":\"tanh\"", "\"activation\":\"relu\""), "w.asmlp"); },
+                     "w.asmlp: header.activation: expected \"tanh\" (got \"relu\")");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"output\":\"clip[-1,1]\"", "\"output\":\"none\""), "w.asmlp"); },
+                     "header.output: expected");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"parameters\":", "\"parameters\":1,\"x\":"), "w.asmlp"); },
+                     "header.parameters: expected");
+  expect_input_error([&] { policy::parse_mlp(with_header_edit(bytes, "\"payload_floats\":", "\"payload_floats\":-1,\"y\":"), "w.asmlp"); },
+                     "header.payload_floats: expected");
+  expect_input_error([&] { policy::load_mlp("/dev/zero"); }, "/dev/zero: not a regular file");
+}
+
 TEST(MlpPolicy, HistoryHoldsTheLastFourActionsMostRecentFirst) {
   // a network whose output is independent of the history, so the history is just its own outputs
   auto w = std::make_shared<policy::MlpWeights>(small_net(sim::TaskId::kPushCube, policy::kHistoryLength));

@@ -182,6 +182,17 @@ TEST(HostileUrdf, NonFiniteOriginIsRejected) {
               ::testing::AnyOf(HasSubstr("origin"), HasSubstr("nan")));
 }
 
+TEST(HostileUrdf, NonFiniteMassInertiaAndShapeSizesAreRejected) {
+  // urdfdom logs these and returns the link without its inertial or collisions: they loaded and ran
+  // (a NaN box changed the episodes) until a logged error became a rejection
+  EXPECT_THAT(rejection(panda_with(R"(<mass value="4.970684"/>)", R"(<mass value="nan"/>)")), HasSubstr("panda_link1"));
+  EXPECT_THAT(rejection(panda_with(R"(<mass value="4.970684"/>)", R"(<mass value="inf"/>)")), HasSubstr("panda_link1"));
+  EXPECT_THAT(rejection(panda_with(R"(ixx="0.70337")", R"(ixx="nan")")), HasSubstr("panda_link1"));
+  EXPECT_THAT(rejection(panda_with(R"(<sphere radius="0.06"/>)", R"(<sphere radius="nan"/>)")), HasSubstr("radius [nan]"));
+  EXPECT_THAT(rejection(panda_with(R"(<cylinder radius="0.06" length="0.283"/>)", R"(<cylinder radius="0.06" length="inf"/>)")),
+              HasSubstr("panda_link1"));
+}
+
 TEST(HostileUrdf, PhysicallyInvalidLimitsAndInertiasAreRejected) {
   EXPECT_THAT(rejection(panda_with(R"(lower="-3.0718" upper="-0.0698")", R"(lower="-0.0698" upper="-3.0718")")),
               HasSubstr("panda_joint4: limit lower"));

@@ -13,6 +13,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/grammar.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/core/rng.hpp"
@@ -136,6 +137,7 @@ class Manifest {
 
   /// Reads and parses a manifest file. Throws InputError naming the file.
   static Manifest load(const std::string& path) {
+    require_regular_file(path, "a manifest file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot open file");
     std::stringstream ss;

@@ -7,6 +7,7 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 
 #include <nlohmann/json.hpp>
@@ -92,6 +93,7 @@ inline void check_payload(const Unframed& u, std::int64_t floats, const std::str
 inline std::string read(const std::string& path, std::uintmax_t max_bytes, const std::string& what) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a file (expected " + what + ")");
+  require_regular_file(path, what);
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size > max_bytes)
     throw InputError(path, "", "weight file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(max_bytes) + ")");
@@ -105,6 +107,7 @@ inline std::string read(const std::string& path, std::uintmax_t max_bytes, const
 /// Writes `bytes` to `path` through a temporary file renamed over it (readers never see half a
 /// file). Throws std::runtime_error naming the path.
 inline void write_atomic(const std::string& path, std::string_view bytes) {
+  require_replaceable_output(path);
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);

@@ -95,6 +95,9 @@ struct JobSpec {
   bool operator==(const JobSpec&) const = default;
 };
 
+/// Largest episode count a job may have.
+inline constexpr std::int64_t kMaxJobEpisodes = 1'000'000'000;
+
 /// Throws actionshift::InputError(source, field, reason) if a field is invalid.
 void validate_job(const JobSpec& job, const std::string& source = "job");
 
