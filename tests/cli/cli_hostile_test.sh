@@ -142,4 +142,76 @@ run timeout 60 "$AS" run --task pick_cube --split reference_seen --method oracle
 expect_rc 2 "a policy that stops reading"
 expect_err "timeout" "a policy that stops reading"
 
+# ---- special files: an input that is a device or FIFO is refused (reading /dev/zero used to grow to
+# gigabytes, a FIFO to block), and an output never replaces one (summarize --out /dev/full replaced
+# the device node); each with `timeout` so a regression fails instead of hanging the suite
+mkfifo "$TMP/fifo"
+for args in "contract hash /dev/zero" "validate /dev/zero" "plan --experiment /dev/zero --out $TMP/pz" \
+            "run --plan /dev/zero" "validate $TMP/fifo"; do
+  # shellcheck disable=SC2086  # the words are the arguments
+  run timeout 20 "$AS" $args
+  expect_rc 2 "special input: $args"
+  expect_one_line_error "special input: $args"
+  expect_err "not a regular file" "special input: $args"
+done
+run timeout 20 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 2 \
+  --backbone mlp:/dev/zero --out "$TMP/mz" --progress off
+expect_rc 2 "weight file /dev/zero"
+expect_err "not a regular file" "weight file /dev/zero"
+mkdir -p "$TMP/rz"
+ln -s /dev/zero "$TMP/rz/$(basename "$JL")"
+run timeout 20 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/rz" --progress off
+expect_rc 2 "results file on /dev/zero"
+expect_err "not a regular file" "results file on /dev/zero"
+run timeout 20 "$AS" summarize "$TMP/r" --out "$TMP/fifo"
+expect_rc 2 "summarize --out a FIFO"
+expect_err "not a regular file (refusing to replace it)" "summarize --out a FIFO"
+[ -p "$TMP/fifo" ] && ok || bad "summarize replaced the FIFO with a regular file"
+
+# ---- a results file with a long unreadable tail is reported, not cut (a torn write is under one line)
+cp "$TMP/clean.jsonl" "$TMP/r/$(basename "$JL")"
+head -c 2000000 /dev/zero >> "$TMP/r/$(basename "$JL")"
+sha_before=$(sha256sum < "$TMP/r/$(basename "$JL")")
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/r" --progress off
+expect_rc 2 "2 MB tail"
+expect_err "too many for a torn write" "2 MB tail"
+[ "$(sha256sum < "$TMP/r/$(basename "$JL")")" = "$sha_before" ] && ok || bad "the 2 MB tail was cut"
+cp "$TMP/clean.jsonl" "$TMP/r/$(basename "$JL")"
+
+# ---- numbers the option parser would wrap or saturate
+for seed in -1 18446744073709551616; do
+  run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --seed "$seed" --out "$TMP/sd" --progress off
+  expect_rc 2 "seed $seed"
+  expect_err "must be an integer in [0, 2**64)" "seed $seed"
+done
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 99999999999999999999 --out "$TMP/sd" --progress off
+expect_rc 2 "episodes beyond int64"
+expect_err "episodes: must be at most 1000000000" "episodes beyond int64"
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --step-timeout nan --out "$TMP/sd" --progress off
+expect_rc 2 "step-timeout nan"
+[ ! -e "$TMP/sd" ] || [ -z "$(ls -A "$TMP/sd")" ] && ok || bad "a refused run wrote results"
+
+# ---- plan --slurm: the partition is written into the scripts, so a shell line there is refused
+cat > "$TMP/tiny.yaml" <<'YAML'
+name: tiny
+tasks: [pick_cube]
+splits: [reference_seen]
+methods: [oracle]
+seeds: [1]
+episodes: 1
+backbone: expert
+pool: null
+YAML
+run "$AS" plan --experiment "$TMP/tiny.yaml" --out "$TMP/sl" --slurm --partition $'p\nrm -rf /'
+expect_rc 2 "partition with a newline"
+expect_one_line_error "partition with a newline"
+[ ! -e "$TMP/sl" ] && ok || bad "plan wrote files for a refused partition"
+
+# ---- montage: a 35-byte GIF declaring a 65535 x 65535 image (giflib's int raster size wraps: a crash)
+printf 'GIF89a\xff\xff\xff\xff\x80\x00\x00\x00\x00\x00\xff\xff\xff\x2c\x00\x00\x00\x00\xff\xff\xff\xff\x00\x02\x02\x44\x01\x00\x3b' > "$TMP/huge.gif"
+run timeout 20 "$AS" montage "$TMP/huge.gif" --out "$TMP/m.gif"
+expect_rc 2 "huge GIF"
+expect_one_line_error "huge GIF"
+expect_err "larger than 8192 pixels" "huge GIF"
+
 finish
