@@ -9,6 +9,7 @@
 #include "actionshift/data/builtin_manifests.hpp"
 #include "commands.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -91,7 +92,12 @@ Mat3 rotation_field(const std::string& where, const nlohmann::json& j) {
   if (j.contains("rotation") && j.contains("quat_wxyz")) throw InputError(where, "rotation", "give rotation or quat_wxyz, not both");
   Mat3 R = Mat3::Identity();
   if (j.contains("quat_wxyz")) {
-    R = quat_wxyz_to_matrix(vec_field<4>(where, j["quat_wxyz"], "quat_wxyz"));
+    const auto q = vec_field<4>(where, j["quat_wxyz"], "quat_wxyz");
+    // a zero quaternion (or one whose norm overflows or underflows) would silently decode as identity
+    const double n = q.norm();
+    if (!(n > 1e-9) || !std::isfinite(n))
+      throw InputError(where, "quat_wxyz", "must be a non-zero quaternion of finite, representable norm (w x y z)");
+    R = quat_wxyz_to_matrix(q);
   } else if (j.contains("rotation")) {
     const auto& r = j["rotation"];
     if (!r.is_array() || r.size() != 3) throw InputError(where, "rotation", "must be a 3x3 list of rows");

@@ -325,6 +325,8 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
   };
   check(expected, source);
   check(actual, "recomputed verdicts");
+  // an expectation with no cells would pass whatever the results say
+  if (expected["cells"].empty()) throw InputError(source, "cells", "no verdicts to check (the file's cells object is empty)");
   if (expected["gate"] != actual["gate"])
     throw InputError(source, "gate", "expected verdicts are for " + expected["gate"].get<std::string>() + ", not " +
                                          actual["gate"].get<std::string>());

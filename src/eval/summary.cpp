@@ -43,6 +43,7 @@ ResultSet load_results(const std::string& dir) {
   };
   std::map<std::pair<std::string, std::int64_t>, Seen> seen;  // (family, episode index) → first record
   std::set<std::pair<std::string, std::string>> overlapping;   // (kept file, skipped file)
+  std::map<std::pair<std::string, std::int64_t>, std::string> where;  // (job id, episode index) → file
   for (const auto& f : out.files) {
     RecordFile rf = read_record_file(f, /*allow_torn_tail=*/true);
     if (rf.torn_tail) out.notes.push_back(f + ": ignored an unterminated last line (job running or killed)");
@@ -58,6 +59,11 @@ ResultSet load_results(const std::string& dir) {
       }
     }
     for (auto& r : rf.records) {
+      // the same record in two files (a copied .jsonl) would be counted twice by every consumer
+      if (const auto [it, fresh] = where.emplace(std::make_pair(r.job_id, r.episode_index), f); !fresh)
+        throw InputError(dir, fs::path(f).filename().string(),
+                         "episode " + std::to_string(r.episode_index) + " of job " + r.job_id.substr(0, 12) + " is also in " +
+                             fs::path(it->second).filename().string() + " (a copy?); keep one file per job");
       if (!family.empty()) {
         const auto [it, inserted] = seen.emplace(std::make_pair(family, r.episode_index), Seen{out.records.size(), f});
         if (!inserted) {

@@ -214,4 +214,23 @@ expect_rc 2 "huge GIF"
 expect_one_line_error "huge GIF"
 expect_err "larger than 8192 pixels" "huge GIF"
 
+# ---- a copied results file is refused by every reader (gate1 counted its episodes twice)
+mkdir -p "$TMP/dup"
+cp "$TMP/clean.jsonl" "$TMP/dup/$(basename "$JL")"
+cp "$TMP/clean.jsonl" "$TMP/dup/copy.jsonl"
+for cmd in summarize gate1; do
+  if [ "$cmd" = summarize ]; then run "$AS" summarize "$TMP/dup"; else run "$AS" gate1 --results "$TMP/dup" --verdict "$TMP/dup.verdict.json"; fi
+  expect_rc 2 "$cmd over a copied jsonl"
+  expect_err "is also in" "$cmd over a copied jsonl"
+done
+# ---- gate check: an expectation with no cells would pass whatever the results say
+printf '{"gate":"gate1","cells":{}}' > "$TMP/empty.verdict.json"
+run "$AS" gate check --expected "$TMP/empty.verdict.json" --actual "$TMP/empty.verdict.json"
+expect_rc 2 "gate check with no cells"
+expect_err "no verdicts to check" "gate check with no cells"
+# ---- a zero quaternion used to decode as the identity rotation
+run "$AS" contract decode '{"contract":{"frame":"tool","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1,1,1,1,1,1],"sign":[1,1,1,1,1,1],"target":"delta"},"raw":[0.5,0.2,0.1,0,0,0,1],"quat_wxyz":[0,0,0,0]}'
+expect_rc 2 "zero quaternion"
+expect_err "quat_wxyz" "zero quaternion"
+
 finish
