@@ -211,6 +211,7 @@ Manifest split_manifest(const std::string& name) {
 
 // the contract of make()/make_vec(): explicit, or test[index] of a split, or identity
 Contract pick_contract(py::handle contract, const std::optional<std::string>& split, std::int64_t index) {
+  if (!split && index != 0) throw InputError("make", "index", "selects a split's contract: give split= too");
   if (!contract.is_none()) {
     if (split) throw InputError("make", "contract", "give either a contract or a split, not both");
     return to_contract(contract);
@@ -722,6 +723,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 // an adapter by method name, with its task's calibration and (for pool methods) a pool
 std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
                                              py::object truth, py::object params) {
+  (void)sim::parse_task(task);  // every method names a task, even those that do not read its calibration
   const std::string text =
       params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
   const nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);

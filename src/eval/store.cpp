@@ -191,6 +191,9 @@ void ResultStore::adopt_from_sibling(const std::string& out_dir, const StoreOpti
       for (auto& r : rf.records) {
         const auto k = static_cast<std::int64_t>(prefix.size());
         if (k >= job_.episodes || r.episode_index != k) break;
+        // a record that does not belong to the sibling (edited, or copied from elsewhere) must not
+        // become part of this job: the throw skips the sibling, and the job runs its episodes itself
+        check_record_belongs(r, other, id, k, jsonl.string());
         prefix.push_back(std::move(r));
       }
       if (prefix.size() > best.size()) {

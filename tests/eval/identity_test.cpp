@@ -139,6 +139,28 @@ TEST_F(IdentityTest, RecordsAndSummariesCarryProvenanceThatIsNotIdentity) {
               ThrowsMessage<InputError>(HasSubstr("bad.jsonl:1: provenance")));
 }
 
+TEST_F(IdentityTest, ASiblingWithARecordOfAnotherJobIsNotAdoptedFrom) {
+  // an edited sibling record used to be copied into the new job and then accepted by every reader
+  std::atomic<int> calls{0};
+  const EpisodeFn base = testing::fake_episode_fn();
+  const EpisodeFn counted = [&](const EpisodeTask& t) {
+    ++calls;
+    return base(t);
+  };
+  const auto small = run_job(testing::fake_job(4), counted, opts("tampered"));
+  std::string text = slurp(small.jsonl_path);
+  const std::string id = job_id(testing::fake_job(4));
+  text.replace(text.find(id), id.size(), std::string(id.size(), 'c'));  // the first record's job id
+  {
+    std::ofstream f(small.jsonl_path, std::ios::binary | std::ios::trunc);
+    f << text;
+  }
+  calls = 0;
+  const auto grown = run_job(testing::fake_job(6), counted, opts("tampered"));
+  EXPECT_EQ(calls.load(), 6) << "nothing is copied from a sibling holding a foreign record";
+  EXPECT_EQ(slurp(grown.jsonl_path), slurp(run_job(testing::fake_job(6), base, opts("clean")).jsonl_path));
+}
+
 TEST_F(IdentityTest, GrowingAJobRunsOnlyTheMissingEpisodesAndMatchesAFreshRun) {
   std::atomic<int> calls{0};
   const EpisodeFn base = testing::fake_episode_fn();

@@ -94,6 +94,8 @@ def test_adapter_errors_are_value_errors():
         actionshift.make_adapter("fixed_probes", task=TASK, pool="reference9", params={"budget": 2 ** 32 + 3})
     with pytest.raises(ValueError, match=r"window: must be in \[1, 1000\]"):
         actionshift.make_adapter("dualabi", task=TASK, pool="reference9", params={"window": 10 ** 7})
+    with pytest.raises(ValueError, match="unknown task 'nope'"):
+        actionshift.make_adapter("no_adapt", task="nope")
     with pytest.raises(TypeError, match="pool: expected a pool name, a manifest path or a list of contracts"):
         actionshift.make_adapter("exact_belief", task=TASK, pool=5)
     assert actionshift.method_params("entropy_probes")["budget"] == 6

@@ -158,6 +158,7 @@ def test_largest_seed_and_numpy_integer_seeds_are_accepted():
     ({"split": 3}, TypeError, "make: split: expected str or None"),
     ({"index": "0"}, TypeError, "make: index: expected int"),
     ({"split": "seen", "index": 2 ** 70}, ValueError, "make: index: out of range"),
+    ({"index": 3}, ValueError, "make: index: selects a split's contract: give split= too"),
 ])
 def test_constructor_arguments_of_the_wrong_type_are_one_line_errors(kwargs, error, pattern):
     args = {"task": "pick_cube", **kwargs}
