@@ -165,6 +165,14 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
   } catch (const std::invalid_argument& e) {
     throw InputError(source, "alpha/sigma", e.what());
   }
+  // what a fit can produce: sigma is floored at 1e-4 when fitted (a smaller one would make the belief
+  // certain after one step), R^2 is at most 1, and a gain is a response per unit command (|alpha| <= 1e3)
+  for (std::size_t i = 0; i < 6; ++i) {
+    if (c.fit.sigma[i] < 1e-4) throw InputError(source, "sigma", "must be at least 1e-4 (the fit's floor)");
+    if (c.fit.fit_r2[i] > 1.0) throw InputError(source, "fit_r2", "must be at most 1");
+    if (std::abs(c.fit.alpha[i]) > 1e3) throw InputError(source, "alpha", "must be at most 1e3 in magnitude");
+  }
+  if (c.rotation_mode != "live") throw InputError(source, "rotation_mode", "must be 'live' (got '" + c.rotation_mode + "')");
   return c;
 }
 

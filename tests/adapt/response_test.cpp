@@ -96,6 +96,20 @@ TEST(ResponseCalibration, JsonRoundTripHashAndErrors) {
   j.erase("alpha");
   EXPECT_THAT([&] { ResponseCalibration::from_json(j.dump(), "cal.json"); }, ThrowsMessage<InputError>(HasSubstr("cal.json: alpha: missing field")));
   EXPECT_THAT([&] { ResponseCalibration::from_json("{", "cal.json"); }, ThrowsMessage<InputError>(HasSubstr("not valid JSON")));
+  // values no fit produces were accepted (a 1e-300 sigma makes the belief certain after one step)
+  const auto edited = [&](const char* key, const nlohmann::json& v) {
+    auto e = nlohmann::json::parse(c.to_json());
+    e[key] = v;
+    return e.dump();
+  };
+  EXPECT_THAT([&] { ResponseCalibration::from_json(edited("sigma", {1e-300, 0.002, 0.002, 0.004, 0.004, 0.004}), "cal.json"); },
+              ThrowsMessage<InputError>(HasSubstr("cal.json: sigma: must be at least 1e-4")));
+  EXPECT_THAT([&] { ResponseCalibration::from_json(edited("fit_r2", {5, 0.99, 0.99, 0.98, 0.98, 0.98}), "cal.json"); },
+              ThrowsMessage<InputError>(HasSubstr("cal.json: fit_r2: must be at most 1")));
+  EXPECT_THAT([&] { ResponseCalibration::from_json(edited("alpha", {1e308, 0.08, 0.08, 0.09, 0.09, 0.09}), "cal.json"); },
+              ThrowsMessage<InputError>(HasSubstr("cal.json: alpha: must be at most 1e3")));
+  EXPECT_THAT([&] { ResponseCalibration::from_json(edited("rotation_mode", "identity"), "cal.json"); },
+              ThrowsMessage<InputError>(HasSubstr("cal.json: rotation_mode: must be 'live'")));
 }
 
 }  // namespace
