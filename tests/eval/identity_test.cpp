@@ -46,6 +46,13 @@ class IdentityTest : public ::testing::Test {
     fs::create_directories(root_);
   }
   void TearDown() override { fs::remove_all(root_); }
+  // the fake episode function, counting its calls (the episodes a job actually ran)
+  EpisodeFn counting(std::atomic<int>& calls) {
+    return [&calls, base = testing::fake_episode_fn()](const EpisodeTask& t) {
+      ++calls;
+      return base(t);
+    };
+  }
   RunOptions opts(const std::string& sub) {
     RunOptions o;
     o.out_dir = (root_ / sub).string();
@@ -143,10 +150,7 @@ TEST_F(IdentityTest, ASiblingWithARecordOfAnotherJobIsNotAdoptedFrom) {
   // an edited sibling record used to be copied into the new job and then accepted by every reader
   std::atomic<int> calls{0};
   const EpisodeFn base = testing::fake_episode_fn();
-  const EpisodeFn counted = [&](const EpisodeTask& t) {
-    ++calls;
-    return base(t);
-  };
+  const EpisodeFn counted = counting(calls);
   const auto small = run_job(testing::fake_job(4), counted, opts("tampered"));
   std::string text = slurp(small.jsonl_path);
   const std::string id = job_id(testing::fake_job(4));
@@ -164,10 +168,7 @@ TEST_F(IdentityTest, ASiblingWithARecordOfAnotherJobIsNotAdoptedFrom) {
 TEST_F(IdentityTest, GrowingAJobRunsOnlyTheMissingEpisodesAndMatchesAFreshRun) {
   std::atomic<int> calls{0};
   const EpisodeFn base = testing::fake_episode_fn();
-  const EpisodeFn counted = [&](const EpisodeTask& t) {
-    ++calls;
-    return base(t);
-  };
+  const EpisodeFn counted = counting(calls);
   run_job(testing::fake_job(10), counted, opts("grow"));
   EXPECT_EQ(calls.load(), 10);
   calls = 0;
