@@ -3,6 +3,7 @@
 #include "actionshift/adapt/identifier.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/eval/identifier_train.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/task.hpp"
@@ -34,6 +35,8 @@ int run_train_identifier(const TrainIdentifierCliOptions& o, std::ostream& out, 
   (void)sim::parse_task(o.task);          // bad input is one line, before anything is printed
   (void)sim::profile_config(o.profile);
   const std::string path = o.out.empty() ? adapt::identifier_weights_path(o.task, *kind) : o.out;
+  require_writable_output(path);  // before the rollouts and the training, not after them
+  if (!o.verdicts.empty()) require_writable_output(o.verdicts);
   std::ostringstream cmd;
   cmd << "actionshift train identifier --kind " << o.kind << " --task " << o.task << " --seed " << o.seed << " --excitation "
       << o.excitation << " --episodes " << o.episodes << " --train-steps " << o.train_steps << " --profile " << o.profile;

@@ -5,6 +5,7 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/input_file.hpp"
 #include "actionshift/policy/gate0.hpp"
 #include "actionshift/policy/ppo.hpp"
 #include "actionshift/policy/registry.hpp"
@@ -67,6 +68,7 @@ int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) 
       throw InputError("", "train bc", "--iterations and --episodes must be positive, --steps non-negative");
     const std::string backbone = o.delay_aware ? "mlp-delay-aware" : "mlp";
     const std::string path = o.out.empty() ? policy::mlp_weights_path(backbone, t.task) : o.out;
+    require_writable_output(path);  // before the DAgger iterations, not after them
     std::string command = "actionshift train bc --task " + o.task + (o.delay_aware ? " --delay-aware" : "") +
                           " --seed " + std::to_string(o.seed) + " --iterations " + std::to_string(o.iterations) +
                           " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps) +
@@ -183,6 +185,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
     const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
+    require_writable_output(path);  // before the run, not after it
     const std::string stem = path.size() > 6 && path.ends_with(".asmlp") ? path.substr(0, path.size() - 6) : path;
     const std::string curve_path = o.curve.empty() ? stem + ".curve.jsonl" : o.curve;
     std::ofstream curve(curve_path, std::ios::trunc);
@@ -323,6 +326,7 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
     run.floor = o.floor;
     run.rule = policy::parse_gate0_rule(o.rule);
     run.threads = o.threads;
+    if (!o.out.empty()) require_writable_output(o.out);  // before the episodes, not after them
     policy::RegistryOptions reg;
     reg.backbones_dir = o.backbones_dir;
     reg.external.step_timeout_s = o.step_timeout_s;

@@ -233,4 +233,15 @@ run "$AS" contract decode '{"contract":{"frame":"tool","gripper_inverted":false,
 expect_rc 2 "zero quaternion"
 expect_err "quat_wxyz" "zero quaternion"
 
+# ---- a long command checks its --out before the work, not after it (train bc wrote nowhere after its DAgger run)
+for args in "train bc --task pick_cube --iterations 1 --episodes 1" "train ppo --task pick_cube --total-steps 1024" \
+            "gate0 --task pick_cube --episodes 2"; do
+  start=$(date +%s)
+  # shellcheck disable=SC2086  # the words are the arguments
+  run timeout 60 "$AS" $args --out "$TMP/no/such/dir/out"
+  expect_rc 2 "$args into a missing directory"
+  expect_err "is not a directory" "$args into a missing directory"
+  [ $(( $(date +%s) - start )) -lt 10 ] && ok || bad "$args worked before refusing its --out"
+done
+
 finish

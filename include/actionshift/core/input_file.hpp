@@ -61,4 +61,15 @@ inline void require_replaceable_output(const std::string& path) {
   if (!std::filesystem::is_regular_file(st)) throw InputError(path, "", "exists and is not a regular file (refusing to replace it)");
 }
 
+/// InputError(path, "", …) unless `path` can be written later: its directory exists and is a
+/// directory, and the path itself is absent or a regular file. Commands that work for minutes (a
+/// training run, a gate) check this first, so a typo in --out does not cost the run.
+inline void require_writable_output(const std::string& path) {
+  require_replaceable_output(path);
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    throw InputError(path, "", "cannot write here: " + parent.string() + " is not a directory");
+}
+
 }  // namespace actionshift
