@@ -119,6 +119,9 @@ int run_montage(const MontageOptions& o) {
   try {
     const Format format = check_output(o.out);
     if (o.inputs.empty()) throw InputError("command line", "inputs", "no GIF to place side by side");
+    if (o.delay_cs < 1 || o.delay_cs > 1000) throw InputError("command line", "--delay", "must be in 1..1000");
+    // every panel is decoded whole before the montage: bounded, as its GIFs are (8192 px a side)
+    if (o.inputs.size() > 16) throw InputError("command line", "inputs", "at most 16 GIFs side by side (got " + std::to_string(o.inputs.size()) + ")");
     std::vector<std::vector<render::Image>> panels;
     std::size_t longest = 0;
     for (const std::string& in : o.inputs) {

@@ -259,7 +259,9 @@ int main(int argc, char** argv) {
   ppo->add_option("--lr", ppo_o.learning_rate, "Adam learning rate")->capture_default_str();
   ppo->add_option("--gamma", ppo_o.gamma, "Discount")->capture_default_str();
   ppo->add_option("--gae-lambda", ppo_o.gae_lambda, "GAE lambda")->capture_default_str();
-  ppo->add_option("--target-kl", ppo_o.target_kl, "Stop an update's epochs above this approximate KL (<= 0: never)")->capture_default_str();
+  ppo->add_option("--target-kl", ppo_o.target_kl, "Stop an update's epochs above this approximate KL (<= 0: never)")
+      ->check(kNotNan)
+      ->capture_default_str();
   ppo->add_option("--hidden", ppo_o.hidden, "Hidden layer widths of actor and critic, comma separated")->capture_default_str();
   ppo->add_option("--eval-every", ppo_o.eval_every, "Iterations between deterministic evaluations (and checkpoints)")->capture_default_str();
   ppo->add_option("--eval-episodes", ppo_o.eval_episodes, "Episodes per evaluation (training seed stream)")->capture_default_str();
@@ -355,7 +357,9 @@ int main(int argc, char** argv) {
                   "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
                   "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");
   run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
-  run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)");
+  run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)")
+      ->check(CLI::Validator(
+          [](std::string& v) { return !v.empty() && v[0] == '-' ? "must be a job index >= 0 (got " + v + ")" : std::string(); }, ""));
   run->add_option("--out", run_o.run.out_dir, "Results directory")->capture_default_str();
   run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores)")->capture_default_str();
   run->add_flag("--fsync", run_o.run.fsync, "fsync after every record");

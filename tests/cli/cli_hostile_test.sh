@@ -244,4 +244,14 @@ for args in "train bc --task pick_cube --iterations 1 --episodes 1" "train ppo -
   [ $(( $(date +%s) - start )) -lt 10 ] && ok || bad "$args worked before refusing its --out"
 done
 
+# ---- option values that used to be accepted: a negative --job-index ran the whole plan
+run "$AS" run --plan "$TMP/none.plan.json" --job-index -1 --out "$TMP/ji" --progress off
+expect_rc 2 "negative job index"
+expect_err "must be a job index >= 0" "negative job index"
+run "$AS" train ppo --task pick_cube --target-kl nan --out "$TMP/kl.asmlp"
+expect_rc 2 "target-kl nan"
+run "$AS" montage "$TMP/huge.gif" --out "$TMP/m.gif" --delay 0
+expect_rc 2 "montage delay 0"
+expect_err "--delay: must be in 1..1000" "montage delay 0"
+
 finish

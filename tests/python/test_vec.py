@@ -37,6 +37,9 @@ def test_vector_env_errors():
     with pytest.raises(ValueError, match="threads"):
         actionshift.make_vec("pick_cube", num_envs=2, threads=-1)
     vec = actionshift.make_vec("pick_cube", num_envs=2)
+    # environment i gets seed + i: a base seed whose last environment would wrap past 2**64 is refused
+    with pytest.raises(ValueError, match=r"seed \+ num_envs - 1 must be below 2\*\*64"):
+        vec.reset(seed=2 ** 64 - 1)
     # stepping before the first reset used to segfault
     with pytest.raises(RuntimeError, match=r"step: called before reset\(\)"):
         vec.step(np.zeros((2, 7)))
