@@ -203,7 +203,7 @@ class VecEnv:
     def reset(self, *, seed=None, options=None):
         """Reset every environment; environment i gets seed ``seed + i``."""
         _check_seed(seed)
-        if seed is not None and seed + self.num_envs - 1 >= 2 ** 64:
+        if seed is not None and int(seed) + self.num_envs - 1 >= 2 ** 64:
             raise ValueError(f"seed: seed + num_envs - 1 must be below 2**64 (environment i gets seed + i; got {seed})")
         return self._env.reset(None if seed is None else int(seed))
 

@@ -40,6 +40,8 @@ def test_vector_env_errors():
     # environment i gets seed + i: a base seed whose last environment would wrap past 2**64 is refused
     with pytest.raises(ValueError, match=r"seed \+ num_envs - 1 must be below 2\*\*64"):
         vec.reset(seed=2 ** 64 - 1)
+    with pytest.raises(ValueError, match=r"seed \+ num_envs - 1 must be below 2\*\*64"):
+        vec.reset(seed=np.uint64(2 ** 64 - 1))  # numpy's own uint64 sum would wrap
     # stepping before the first reset used to segfault
     with pytest.raises(RuntimeError, match=r"step: called before reset\(\)"):
         vec.step(np.zeros((2, 7)))
