@@ -7,6 +7,7 @@
 #include "actionshift/adapt/calibration.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
 
 #include <cstdio>
@@ -17,11 +18,7 @@ namespace actionshift::cli {
 int run_bench_adapt(const BenchAdaptOptions& o) {
   adapt::AdapterBenchConfig cfg;
   cfg.method = o.method;
-  try {
-    cfg.params = nlohmann::json::parse(o.params);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError("", "--params", std::string("not JSON: ") + e.what());
-  }
+  cfg.params = parse_json_input(o.params, "command line", "--params");
   if (!cfg.params.is_object()) throw InputError("", "--params", "must be a JSON object");
   cfg.params = adapt::resolve_method_params(o.method, cfg.params);  // unknown method / parameter: InputError
   if (adapt::method_needs_pool(o.method)) {

@@ -7,6 +7,7 @@
 #include "actionshift/core/transforms.hpp"
 #include "actionshift/core/validate.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
+#include "cmd_eval.hpp"
 #include "commands.hpp"
 
 #include <cmath>
@@ -281,17 +282,24 @@ int run_splits_generate(const SplitsGenerateOptions& o) {
   const std::vector<std::string> rules = o.rules.empty() ? all : o.rules;
   for (const auto& r : rules)
     if (std::find(all.begin(), all.end(), r) == all.end()) throw InputError("--rule", r, "unknown split rule");
-  fs::create_directories(o.out_dir);
+  check_output_dir(o.out_dir, "--out");
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec) throw InputError(o.out_dir, "--out", "cannot create directory: " + ec.message());
   for (const auto& r : rules) {
     const Manifest m = splits::generate(r, o.seed);
     const fs::path path = fs::path(o.out_dir) / (r + ".json");
+    require_replaceable_output(path.string());  // a directory, FIFO or device of that name is not replaced
     const fs::path tmp = path.string() + ".tmp";
     {
-      std::ofstream out(tmp, std::ios::binary);
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
       out << m.serialize();
       if (!out) throw InputError(tmp.string(), "", "cannot write file");
     }
-    fs::rename(tmp, path);
+    if (fs::rename(tmp, path, ec); ec) {
+      fs::remove(tmp, ec);
+      throw InputError(path.string(), "--out", "cannot replace file: " + ec.message());
+    }
     std::cout << path.string() << "  " << (m.is_pool() ? "pool " : "split ") << m.test().size() << " contracts  manifest_sha256 "
               << m.manifest_sha256() << "\n";
   }

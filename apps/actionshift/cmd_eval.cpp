@@ -249,7 +249,8 @@ int run_gate_check(const GateCheckOptions& o, std::ostream& out, std::ostream& e
         actual = eval::promotion_report(rs.records, expected["candidate"].get<std::string>(), expected["baseline"].get<std::string>());
       }
     }
-    const auto changes = eval::compare_verdicts(expected, actual, o.expected_file);
+    const auto changes = eval::compare_verdicts(expected, actual, o.expected_file,
+                                                o.actual_file.empty() ? "verdicts recomputed from " + o.results_dir : o.actual_file);
     std::size_t regressions = 0;
     for (const auto& c : changes) {
       out << c.line << "\n";
@@ -383,6 +384,19 @@ int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::os
   return guarded(err, [&] {
     check_output_dir(o.out_dir, "--out");
     const eval::Plan plan = eval::load_plan(o.plan_file);
+    // a failing job is named by its plan entry (announce's line is not printed with --progress off)
+    const auto run_entry = [&](const eval::PlannedJob& pj) {
+      const std::string field = "jobs[" + std::to_string(pj.index) + "] (" + pj.job_id.substr(0, 12) + ")";
+      try {
+        run_with(pj.spec, o, make, out, err);
+      } catch (const eval::Interrupted&) {
+        throw;
+      } catch (const std::invalid_argument& e) {
+        throw InputError(o.plan_file, field, e.what());
+      } catch (const std::runtime_error& e) {
+        throw std::runtime_error(o.plan_file + ": " + field + ": " + e.what());
+      }
+    };
     if (o.job_index) {
       if (*o.job_index < 0 || *o.job_index >= static_cast<std::int64_t>(plan.jobs.size()))
         throw InputError(o.plan_file, "--job-index",
@@ -390,12 +404,12 @@ int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::os
                              std::to_string(*o.job_index) + ")");
       const auto& pj = plan.jobs[static_cast<std::size_t>(*o.job_index)];
       announce(pj, plan.jobs.size(), o, err);
-      run_with(pj.spec, o, make, out, err);
+      run_entry(pj);
       return kOk;
     }
     for (const auto& pj : plan.jobs) {
       announce(pj, plan.jobs.size(), o, err);
-      run_with(pj.spec, o, make, out, err);
+      run_entry(pj);
     }
     return kOk;
   });

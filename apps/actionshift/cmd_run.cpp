@@ -98,7 +98,16 @@ int run_run(const RunCliOptions& o) {
       job.calibration_sha256 = cal.sha256();
       options.calibration = std::move(cal);
     }
-    const EpisodeFnFactory factory = [options](const eval::JobSpec& j) { return eval::make_episode_fn(j, options); };
+    const std::string calibration_file = o.calibration;
+    const EpisodeFnFactory factory = [options, calibration_file](const eval::JobSpec& j) {
+      try {
+        return eval::make_episode_fn(j, options);
+      } catch (const InputError& e) {
+        // the episode function checks a given calibration against the task; the file's name is known here
+        if (e.source() == "calibration" && !calibration_file.empty()) throw InputError(calibration_file, e.field(), e.reason());
+        throw;
+      }
+    };
     return run_one_job(job, o.run, factory);
   } catch (const eval::Interrupted&) {
     throw;  // not an error: main says where the job stopped (exit 130)

@@ -7,6 +7,7 @@
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/manifest.hpp"
 #include "actionshift/core/transforms.hpp"
@@ -68,8 +69,21 @@ std::string shape_of(const DArray& a) {
 }
 
 // pybind11's ensure() returns a null array (its error cleared) when h cannot be converted
+// `h` as a C-contiguous array of doubles, or a null array (the caller reports it) if numpy cannot
+// make an array of it. Only real numbers (bool, integer, float dtypes) are converted: forcecast
+// alone would also turn complex numbers (dropping the imaginary part) and strings ("1.5") into
+// doubles. A numpy array is inspected as it is; anything else through numpy's own type inference.
+DArray ensure_numbers(py::handle h, const std::string& what) {
+  py::array raw = py::isinstance<py::array>(h) ? py::reinterpret_borrow<py::array>(h) : py::array::ensure(h);
+  if (!raw) return DArray();
+  const char kind = raw.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+    value_error(what + ": must hold real numbers (got dtype " + py::str(raw.dtype()).cast<std::string>() + ")");
+  return DArray::ensure(raw);
+}
+
 DArray as_array(py::handle h, const char* what) {
-  DArray a = DArray::ensure(h);
+  DArray a = ensure_numbers(h, what);
   if (!a) {
     PyErr_Clear();
     value_error(std::string(what) + ": not convertible to an array of numbers");
@@ -80,7 +94,7 @@ DArray as_array(py::handle h, const char* what) {
 // a 1-D array of exactly n numbers (a list, tuple or numpy array of any numeric dtype)
 template <int N>
 Eigen::Matrix<double, N, 1> to_vec(py::handle h, const char* what) {
-  DArray a = DArray::ensure(h);
+  DArray a = ensure_numbers(h, what);
   if (!a) {
     PyErr_Clear();
     value_error(std::string(what) + ": must be " + std::to_string(N) + " numbers");
@@ -94,7 +108,7 @@ Eigen::Matrix<double, N, 1> to_vec(py::handle h, const char* what) {
 
 Mat3 to_rotation(py::handle h, const char* what) {
   if (h.is_none()) return Mat3::Identity();
-  DArray a = DArray::ensure(h);
+  DArray a = ensure_numbers(h, what);
   if (!a) {
     PyErr_Clear();
     value_error(std::string(what) + ": must be a 3x3 rotation matrix");
@@ -303,7 +317,7 @@ class PyEnv {
 
   py::tuple step(py::handle action) {
     if (!last_seed_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
-    DArray a = DArray::ensure(action);
+    DArray a = ensure_numbers(action, "action");
     if (!a) {
       PyErr_Clear();
       value_error("action: not convertible to an array of numbers");
@@ -474,7 +488,7 @@ class PyVecEnv {
 
   py::tuple step(py::handle actions) {
     if (!last_seed_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
-    DArray a = DArray::ensure(actions);
+    DArray a = ensure_numbers(actions, "actions");
     if (!a) {
       PyErr_Clear();
       value_error("actions: not convertible to an array of numbers");
@@ -726,8 +740,8 @@ std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const st
   (void)sim::parse_task(task);  // every method names a task, even those that do not read its calibration
   const std::string text =
       params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
-  const nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);
-  if (parsed.is_discarded() || !parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
+  const nlohmann::json parsed = parse_json_input(text, "method " + method, "params");
+  if (!parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
   const nlohmann::json p = adapt::resolve_method_params(method, parsed);
   struct Holder {
     std::vector<Contract> pool;

@@ -76,12 +76,17 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   if (std::find(names.begin(), names.end(), method) == names.end()) {
     std::string known;
     for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("method", method, "unknown method (known: " + known + ")");
+    throw InputError("method", printable_input(method), "unknown method (known: " + known + ")");
   }
   if (!params.is_object()) throw InputError("method", method, "parameters must be a JSON object");
   nlohmann::json out = defaults(method);
   for (auto it = params.begin(); it != params.end(); ++it) {
-    if (!out.contains(it.key())) throw InputError("method " + method, it.key(), "unknown parameter");
+    if (!out.contains(it.key())) {
+      std::string known;
+      for (auto k = out.begin(); k != out.end(); ++k) known += (known.empty() ? "" : ", ") + k.key();
+      throw InputError("method " + method, printable_input(it.key()),
+                       known.empty() ? "unknown parameter (this method takes none)" : "unknown parameter (known: " + known + ")");
+    }
     const auto& d = out[it.key()];
     const auto& v = it.value();
     const bool ok = (d.is_string() && v.is_string()) || (d.is_boolean() && v.is_boolean()) || (d.is_number_integer() && v.is_number_integer()) ||
@@ -119,7 +124,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
       if (v == a) return;
       list += (list.empty() ? "" : ", ") + std::string(a);
     }
-    throw InputError("method " + method, key, "must be one of " + list + " (got '" + v + "')");
+    throw InputError("method " + method, key, "must be one of " + list + " (got " + quote_input(v) + ")");
   };
   one_of("probe", {"none", "fixed", "hold", "entropy"});
   one_of("after_probe", {"belief", "identity"});

@@ -254,13 +254,21 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
                                          : "does not match the built-in calibration of " + job.task + " on profile " + job.profile +
                                                " (" + cal.sha256() + ")");
     if (given_calibration && cal.task != job.task)
-      throw InputError("calibration", "task", "is " + cal.task + ", not the job's " + job.task);
-    if (cal.slice.position_start != ctx->slice.position_start || cal.slice.quaternion_start != ctx->slice.quaternion_start)
-      throw InputError("calibration " + job.task, "position_start", "does not match the task's observation layout");
+      throw InputError("calibration", "task", "is " + cal.task + ", not the job's " + job.task);  // named by the caller too
+    // a given file is named by the caller, which knows its path (source "calibration")
+    const std::string cal_source = given_calibration ? "calibration" : "built-in calibration " + job.task;
+    const auto layout_error = [&](const char* field, int is, int want) {
+      return InputError(cal_source, field,
+                        "is " + std::to_string(is) + ", but " + job.task + "'s observation has it at " + std::to_string(want));
+    };
+    if (cal.slice.position_start != ctx->slice.position_start)
+      throw layout_error("position_start", cal.slice.position_start, ctx->slice.position_start);
+    if (cal.slice.quaternion_start != ctx->slice.quaternion_start)
+      throw layout_error("quaternion_start", cal.slice.quaternion_start, ctx->slice.quaternion_start);
     ctx->response = cal.model();
     if (cal.gripper) {
       if (cal.gripper->start != finger_start(ctx->model->layout()))
-        throw InputError("calibration " + job.task, "gripper.start", "does not match the task's observation layout");
+        throw layout_error("gripper.start", cal.gripper->start, finger_start(ctx->model->layout()));
       ctx->finger_start = cal.gripper->start;
     }
   }

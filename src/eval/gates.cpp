@@ -315,7 +315,7 @@ std::optional<std::int64_t> cell_episodes(const json& cell) {
 }  // namespace
 
 std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, const nlohmann::json& actual,
-                                            const std::string& source) {
+                                            const std::string& source, const std::string& actual_source) {
   auto check = [&](const json& j, const std::string& name) {
     if (!j.is_object() || !j.contains("gate") || !j["gate"].is_string() || !j.contains("cells") || !j["cells"].is_object())
       throw InputError(name, "cells", "not a verdict file (needs \"gate\" and a \"cells\" object)");
@@ -324,7 +324,7 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
         throw InputError(name, "cells." + it.key() + ".verdict", "missing verdict string");
   };
   check(expected, source);
-  check(actual, "recomputed verdicts");
+  check(actual, actual_source);
   // an expectation with no cells would pass whatever the results say
   if (expected["cells"].empty()) throw InputError(source, "cells", "no verdicts to check (the file's cells object is empty)");
   if (expected["gate"] != actual["gate"])
@@ -396,7 +396,12 @@ json promotion_report(const std::vector<EpisodeRecord>& records, const std::stri
             {"cells", json::object()}};
   for (const auto& [key, pair] : cells) {
     if (pair.first.empty() || pair.second.empty()) continue;
-    const PromotionVerdict v = promotion_verdict(pair.first, pair.second, samples, seed);
+    PromotionVerdict v;
+    try {
+      v = promotion_verdict(pair.first, pair.second, samples, seed);
+    } catch (const InputError& e) {
+      throw InputError("promotion", key, candidate + " vs " + baseline + ": " + e.reason());
+    }
     j["cells"][key] = {{"task", pair.first.front().task},
                        {"split", pair.first.front().split},
                        {"backbone", pair.first.front().backbone},

@@ -5,6 +5,7 @@
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/store.hpp"
+#include "actionshift/sim/task.hpp"
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -118,6 +119,7 @@ json to_json_value(const YAML::Node& n, const std::string& source, const std::st
       const std::string key = kv.first.Scalar();
       if (invalid_utf8_offset(key) != std::string::npos)
         throw InputError(at_line(source, kv.first), field, "map key is not valid UTF-8");
+      if (o.contains(key)) throw InputError(at_line(source, kv.first), field + "." + key, "duplicate key");
       o[key] = to_json_value(kv.second, source, field + "." + key, depth + 1, budget);
     }
     return o;
@@ -194,12 +196,14 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
   static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
                                                "seeds",    "episodes",    "backbone", "pool",   "rotation_mode", "profile"};
+  std::set<std::string> seen_keys;  // yaml-cpp keeps both entries of a repeated key and reads the first
   for (const auto& kv : root) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
     if (!known.count(key))
       throw InputError(at_line(source, kv.first), key,
                        "unknown key (expected one of name, description, tasks, splits, methods, seeds, episodes, "
                        "backbone, pool, rotation_mode, profile)");
+    if (!seen_keys.insert(key).second) throw InputError(at_line(source, kv.first), key, "duplicate key");
   }
   for (const char* key : {"name", "tasks", "splits", "methods", "seeds", "episodes", "backbone"})
     if (!root[key]) throw InputError(source, key, "missing required key");
@@ -223,10 +227,12 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     if (m.IsScalar()) {
       entry.name = require_token(m, source, f);
     } else if (m.IsMap()) {
+      std::set<std::string> entry_keys;
       for (const auto& kv : m) {
-        const std::string key = kv.first.Scalar();
+        const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
         if (key != "name" && key != "params")
           throw InputError(at_line(source, kv.first), f + "." + key, "unknown key (expected name, params)");
+        if (!entry_keys.insert(key).second) throw InputError(at_line(source, kv.first), f + "." + key, "duplicate key");
       }
       if (!m["name"]) throw InputError(at_line(source, m), f + ".name", "missing required key");
       entry.name = require_token(m["name"], source, f + ".name");
@@ -321,6 +327,24 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   return job;
 }
 
+namespace {
+
+// `f()`, with a failure re-thrown as the experiment file's error at `field` (a resolver knows the
+// name it was given, not which line of which file named it)
+template <class F>
+auto in_experiment(const Experiment& ex, const std::string& field, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (e.source() == ex.source) throw;
+    throw InputError(ex.source, field, e.what());
+  } catch (const std::invalid_argument& e) {
+    throw InputError(ex.source, field, e.what());
+  }
+}
+
+}  // namespace
+
 Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("make_plan: resolver needs split and backbone");
   if (ex.pool && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");
@@ -333,33 +357,50 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
     const auto it = ex.split_pools.find(split_name);
     const std::optional<std::string> name = it != ex.split_pools.end() ? it->second : ex.pool;
     if (name && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");
-    pools[split_name] = name ? std::optional<PoolRef>(resolver.pool(*name)) : std::nullopt;
+    const std::string field = it != ex.split_pools.end() ? "pool." + split_name : "pool";
+    pools[split_name] = name ? std::optional<PoolRef>(in_experiment(ex, field, [&] { return resolver.pool(*name); })) : std::nullopt;
   }
+  const auto method_field = [](std::size_t i) { return "methods[" + std::to_string(i) + "]"; };
   if (resolver.check_method)
-    for (const auto& m : ex.methods) resolver.check_method(m);
+    for (std::size_t i = 0; i < ex.methods.size(); ++i)
+      in_experiment(ex, method_field(i), [&] { resolver.check_method(ex.methods[i]); });
   std::set<std::string> ids;
-  for (const auto& task : ex.tasks) {
-    const BackboneRef backbone = resolver.backbone(task, ex.backbone);
-    for (const auto& split_name : ex.splits) {
-      const SplitRef split = resolver.split(task, split_name);
-      for (const auto& method : ex.methods) {
+  for (std::size_t t = 0; t < ex.tasks.size(); ++t) {
+    const std::string& task = ex.tasks[t];
+    const std::string task_field = "tasks[" + std::to_string(t) + "]";
+    in_experiment(ex, task_field, [&] { (void)sim::parse_task(task); });
+    const BackboneRef backbone =
+        in_experiment(ex, "backbone", [&] { return resolver.backbone(task, ex.backbone); });
+    for (std::size_t s = 0; s < ex.splits.size(); ++s) {
+      const std::string& split_name = ex.splits[s];
+      const SplitRef split =
+          in_experiment(ex, "splits[" + std::to_string(s) + "]", [&] { return resolver.split(task, split_name); });
+      for (std::size_t m = 0; m < ex.methods.size(); ++m) {
+        const MethodEntry& method = ex.methods[m];
         const std::optional<std::string> calibration =
-            resolver.calibration ? resolver.calibration(task, method, ex.profile) : std::nullopt;
+            resolver.calibration
+                ? in_experiment(ex, method_field(m), [&] { return resolver.calibration(task, method, ex.profile); })
+                : std::nullopt;
+        const std::string params = resolver.method_params
+                                       ? in_experiment(ex, method_field(m), [&] { return resolver.method_params(method); })
+                                       : method.params;
+        const bool uses_pool =
+            !resolver.method_uses_pool || in_experiment(ex, method_field(m), [&] { return resolver.method_uses_pool(method); });
         for (const auto seed : ex.seeds) {
           PlannedJob pj;
           pj.index = static_cast<std::int64_t>(plan.jobs.size());
           pj.spec.task = task;
           pj.spec.split = split;
           pj.spec.method = method.name;
-          pj.spec.method_params = resolver.method_params ? resolver.method_params(method) : method.params;
+          pj.spec.method_params = params;
           pj.spec.backbone = backbone;
-          if (!resolver.method_uses_pool || resolver.method_uses_pool(method)) pj.spec.pool = pools[split_name];
+          if (uses_pool) pj.spec.pool = pools[split_name];
           pj.spec.calibration_sha256 = calibration;
           pj.spec.rotation_mode = ex.rotation_mode;
           pj.spec.profile = ex.profile;
           pj.spec.seed = seed;
           pj.spec.episodes = ex.episodes;
-          validate_job(pj.spec, ex.source);
+          in_experiment(ex, task_field, [&] { validate_job(pj.spec, ex.source); });
           pj.job_id = job_id(pj.spec);
           if (!ids.insert(pj.job_id).second)
             throw InputError(ex.source, "", "two plan entries resolve to the same job " + pj.job_id);

@@ -1,14 +1,15 @@
 #include "actionshift/eval/summary.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/store.hpp"
+#include "io.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -51,8 +52,9 @@ ResultSet load_results(const std::string& dir) {
     const fs::path summary = fs::path(f).replace_extension(".summary.json");
     if (fs::exists(summary, ec)) {
       try {
-        std::ifstream in(summary, std::ios::binary);
-        const JobSpec job = job_from_json(json::parse(in).at("job"), summary.string());
+        // a FIFO or device named like a summary must not block or stream: read_file refuses it
+        const JobSpec job = job_from_json(parse_json_input(detail::read_file(summary.string()), summary.string()).at("job"),
+                                          summary.string());
         if (job_id(job) == fs::path(f).stem().string()) family = family_key(job);
       } catch (const std::exception&) {
         family.clear();  // no usable summary: the job's records stand alone

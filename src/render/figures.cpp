@@ -194,8 +194,10 @@ std::optional<Figure> gate1_figure(const std::vector<eval::CellSummary>& cells, 
     seen.insert(ts);
     Group g;
     g.label = c.key.task + "/" + c.key.split;
-    if (verdict && verdict->contains("cells") && (*verdict)["cells"].contains(g.label))
-      g.note = (*verdict)["cells"][g.label].value("verdict", "");
+    if (verdict && verdict->contains("cells") && (*verdict)["cells"].contains(g.label)) {
+      const nlohmann::json& cell = (*verdict)["cells"][g.label];
+      if (cell.is_object() && cell.contains("verdict") && cell["verdict"].is_string()) g.note = cell["verdict"].get<std::string>();
+    }
     g.bars = {{"oracle", o}, {"no_adapt", n}};
     groups.push_back(std::move(g));
   }

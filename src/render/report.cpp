@@ -93,6 +93,12 @@ ReportResult write_report(const std::string& results_dir, const std::string& out
     } else if (ends(".verdict.json") || (name.rfind("promotion.", 0) == 0 && ends(".json"))) {
       json j = read_json(p);
       if (!j.contains("cells") || !j["cells"].is_object()) throw InputError(p.string(), "cells", "missing: not a verdict file");
+      for (auto it = j["cells"].begin(); it != j["cells"].end(); ++it) {
+        if (!it.value().is_object()) throw InputError(p.string(), "cells." + it.key(), "expected an object");
+        for (const char* k : {"verdict", "decision", "reason"})
+          if (it.value().contains(k) && !it.value()[k].is_string())
+            throw InputError(p.string(), "cells." + it.key() + "." + k, "expected a string");
+      }
       verdicts.push_back({name, std::move(j)});
     }
   }

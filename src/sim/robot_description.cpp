@@ -55,9 +55,10 @@ std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& fi
     std::lock_guard<std::mutex> lock(mutex);
     if (auto it = cache.find(key); it != cache.end()) return it->second;
   }
+  const std::string shown = quote_input(key, '\'', 300);  // a path from the URDF, quoted and cut
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
-    fail(origin, "mesh file not found: " + key);
+    fail(origin, "mesh file not found: " + shown);
   Assimp::Importer importer;
   // Collada files carry an <up_axis>; assimp rotates Z_UP files into its Y-up convention by default,
   // which would turn a .dae collision mesh 90 degrees about x relative to its STL/OBJ twin. A URDF
@@ -65,7 +66,7 @@ std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& fi
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const aiScene* scene = importer.ReadFile(key, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || scene->mRootNode == nullptr || scene->mNumMeshes == 0)
-    fail(origin, "cannot read mesh " + key + " (" + importer.GetErrorString() + ")");
+    fail(origin, "cannot read mesh " + shown + " (" + importer.GetErrorString() + ")");
   auto mesh = std::make_shared<MeshData>();
   mesh->source = key;
   // walk the node tree (explicitly, a hostile file may nest nodes deeply) so node transforms are applied
@@ -74,21 +75,21 @@ std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& fi
   while (!stack.empty()) {
     const auto [node, parent] = stack.back();
     stack.pop_back();
-    if (++visited > kMaxMeshNodes) fail(origin, "mesh " + key + " has more than " + std::to_string(kMaxMeshNodes) + " nodes");
+    if (++visited > kMaxMeshNodes) fail(origin, "mesh " + shown + " has more than " + std::to_string(kMaxMeshNodes) + " nodes");
     const aiMatrix4x4 m = parent * node->mTransformation;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
-      if (node->mMeshes[i] >= scene->mNumMeshes) fail(origin, "mesh " + key + ": a node names a mesh that does not exist");
+      if (node->mMeshes[i] >= scene->mNumMeshes) fail(origin, "mesh " + shown + ": a node names a mesh that does not exist");
       const aiMesh* am = scene->mMeshes[node->mMeshes[i]];
       for (unsigned v = 0; v < am->mNumVertices; ++v) {
         const aiVector3D p = m * am->mVertices[v];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-          fail(origin, "mesh " + key + " has a non-finite vertex");
+          fail(origin, "mesh " + shown + " has a non-finite vertex");
         mesh->vertices.emplace_back(p.x, p.y, p.z);
       }
     }
     for (unsigned c = 0; c < node->mNumChildren; ++c) stack.emplace_back(node->mChildren[c], m);
   }
-  if (mesh->vertices.size() < 4) fail(origin, "mesh " + key + " has fewer than 4 vertices");
+  if (mesh->vertices.size() < 4) fail(origin, "mesh " + shown + " has fewer than 4 vertices");
   std::lock_guard<std::mutex> lock(mutex);
   return cache.emplace(key, std::move(mesh)).first->second;
 }
@@ -102,7 +103,9 @@ std::filesystem::path resolve_uri(const std::string& uri, const std::filesystem:
     const auto slash = rest.find('/');
     const std::string pkg = rest.substr(0, slash);
     const auto it = packages.find(pkg);
-    if (it == packages.end()) fail(origin, "mesh " + uri + ": package '" + pkg + "' not in the package map");
+    if (it == packages.end())
+      fail(origin, "mesh " + quote_input(uri, '\'', 300) + ": package " + quote_input(pkg) +
+                       " not in the package map (give --package NAME=DIR)");
     return slash == std::string::npos ? it->second : it->second / rest.substr(slash + 1);
   }
   if (uri.rfind(kFile, 0) == 0) return std::filesystem::path(uri.substr(kFile.size()));

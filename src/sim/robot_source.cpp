@@ -4,9 +4,12 @@
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/sim/env.hpp"
+#include "actionshift/sim/kinematics.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -61,6 +64,36 @@ std::string robot_content_sha256(std::string_view urdf_bytes, const RobotDescrip
   return sha256_hex(canonical_dump(j));
 }
 
+namespace {
+
+// the parts the environment drives must exist: checked here, where the file is known, so a plan
+// with a robot that is not a Panda fails when it is made, naming the URDF, and not job by job
+void check_drivable(const RobotDescription& desc, const std::string& urdf) {
+  const RobotNames names;
+  const std::string what = "the environment drives a 7-joint arm ending at link '" + names.tcp_link +
+                           "' and the finger joints '" + names.left_finger_joint + "' and '" + names.right_finger_joint + "'";
+  const auto has_link = [&](const std::string& n) {
+    return std::any_of(desc.links.begin(), desc.links.end(), [&](const LinkDescription& l) { return l.name == n; });
+  };
+  const auto has_joint = [&](const std::string& n) {
+    return std::any_of(desc.joints.begin(), desc.joints.end(), [&](const JointDescription& j) { return j.name == n; });
+  };
+  if (!has_link(names.tcp_link)) throw InputError(urdf, "robot.tcp_link", "no link named '" + names.tcp_link + "' (" + what + ")");
+  for (const std::string* j : {&names.left_finger_joint, &names.right_finger_joint})
+    if (!has_joint(*j)) throw InputError(urdf, "robot.fingers", "no joint named '" + *j + "' (" + what + ")");
+  int dof = 0;
+  try {
+    dof = KinematicChain(desc, names.tcp_link).dof();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(urdf, "robot.arm", e.what());
+  }
+  if (dof != 7)
+    throw InputError(urdf, "robot.arm",
+                     "the chain to '" + names.tcp_link + "' has " + std::to_string(dof) + " movable joints, 7 expected");
+}
+
+}  // namespace
+
 RobotSource load_robot_source(const std::string& urdf, const std::map<std::string, std::string>& packages) {
   std::error_code ec;
   if (!fs::is_regular_file(urdf, ec)) throw InputError(urdf, "--robot", "no such URDF file");
@@ -71,6 +104,7 @@ RobotSource load_robot_source(const std::string& urdf, const std::map<std::strin
   for (const auto& [name, dir] : packages) pm[name] = dir;
   const std::string bytes = read_bytes(r.urdf, "--robot");
   auto desc = std::make_shared<RobotDescription>(load_urdf_file(r.urdf, pm));
+  check_drivable(*desc, urdf);
   r.sha256 = robot_content_sha256(bytes, *desc);
   r.description = std::move(desc);
   return r;

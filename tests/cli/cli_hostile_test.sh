@@ -254,4 +254,69 @@ run "$AS" montage "$TMP/huge.gif" --out "$TMP/m.gif" --delay 0
 expect_rc 2 "montage delay 0"
 expect_err "--delay: must be in 1..1000" "montage delay 0"
 
+# ---- a repeated key: the second value used to win silently (JSON) or be ignored (YAML)
+run "$AS" contract hash '{"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1,1,1,1,1,1],"sign":[1,1,1,1,1,1],"target":"delta","lag":2}'
+expect_rc 2 "contract with a repeated key"
+expect_one_line_error "contract with a repeated key"
+expect_err "lag: duplicate key in one object" "contract with a repeated key"
+printf 'name: dup\ntasks: [pick_cube]\nsplits: [reference_seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 2\nepisodes: 2000\nbackbone: expert\n' > "$TMP/dup.yaml"
+run "$AS" plan --experiment "$TMP/dup.yaml" --out "$TMP/dupplan"
+expect_rc 2 "experiment with a repeated key"
+expect_err "dup.yaml:7: episodes: duplicate key" "experiment with a repeated key"
+[ ! -e "$TMP/dupplan" ] && ok || bad "a refused experiment left a plan directory"
+
+# ---- splits generate --out: raw std::filesystem messages, and a FIFO in the way was replaced
+touch "$TMP/plainfile"
+run "$AS" splits generate --out "$TMP/plainfile"
+expect_rc 2 "splits generate into a file"
+expect_one_line_error "splits generate into a file"
+expect_err "plainfile: --out: exists and is not a directory" "splits generate into a file"
+mkdir -p "$TMP/gen_fifo" && mkfifo "$TMP/gen_fifo/seen.json"
+run timeout 20 "$AS" splits generate --out "$TMP/gen_fifo" --rule seen
+expect_rc 2 "splits generate over a FIFO"
+expect_err "seen.json" "splits generate over a FIFO"
+[ -p "$TMP/gen_fifo/seen.json" ] && ok || bad "splits generate replaced a FIFO"
+[ -z "$(find "$TMP/gen_fifo" -name '*.tmp')" ] && ok || bad "splits generate left a temporary file"
+
+# ---- report: a verdict cell that is not an object was nlohmann's raw type_error 306
+mkdir -p "$TMP/rep" && cp "$TMP/clean.jsonl" "$TMP/rep/"
+echo '{"gate":"gate1","cells":{"pick_cube/reference_seen":"pass"}}' > "$TMP/rep/gate1.verdict.json"
+run "$AS" report "$TMP/rep" --out "$TMP/rep/out"
+expect_rc 2 "report with a malformed verdict cell"
+expect_one_line_error "report with a malformed verdict cell"
+expect_err "gate1.verdict.json: cells.pick_cube/reference_seen: expected an object" "report with a malformed verdict cell"
+
+# ---- a FIFO named like a job summary beside its records: summarize must not block on it
+mkdir -p "$TMP/fifo_sum" && cp "$TMP/clean.jsonl" "$TMP/fifo_sum/"
+mkfifo "$TMP/fifo_sum/$(basename "$TMP/clean.jsonl" .jsonl).summary.json"
+run timeout 20 "$AS" summarize "$TMP/fifo_sum"
+expect_rc 0 "summarize beside a FIFO summary"
+
+# ---- selftest --sim --calibration of another task read the pose at that task's offsets
+run "$AS" selftest --sim --task push_cube --hidden-contract identity \
+  --calibration "$SRC/configs/calibration/maniskill/selftest/pick_cube.json"
+expect_rc 3 "selftest with another task's calibration"
+expect_err "pick_cube.json: task: is pick_cube, not --task push_cube" "selftest with another task's calibration"
+run "$AS" selftest --sim --task pick_cube --profile ideal --hidden-contract identity \
+  --calibration "$SRC/configs/calibration/maniskill/selftest/pick_cube.json"
+expect_rc 3 "selftest with another profile's calibration"
+expect_err "profile: was measured on maniskill, not on --profile ideal" "selftest with another profile's calibration"
+
+# ---- run --plan: a failing job is named by its plan entry, also with --progress off
+cat > "$TMP/dies.py" <<'PY'
+import sys
+for line in sys.stdin:  # answers the hello, then exits at the first step
+    if '"hello"' in line:
+        print('{"type":"ready"}', flush=True)
+    elif '"step"' in line:
+        sys.exit(1)
+PY
+printf 'name: failing\ntasks: [pick_cube]\nsplits: [reference_seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 1\nbackbone: "external:python3 %s"\n' "$TMP/dies.py" > "$TMP/failing.yaml"
+run "$AS" plan --experiment "$TMP/failing.yaml" --out "$TMP/failing"
+expect_rc 0 "plan of an external backbone"
+run timeout 60 "$AS" run --plan "$TMP/failing/failing.plan.json" --out "$TMP/failing" --progress off
+expect_rc 2 "run --plan with a failing job"
+expect_one_line_error "run --plan with a failing job"
+expect_err "failing.plan.json: jobs[0] (" "run --plan with a failing job names the entry"
+
 finish

@@ -120,5 +120,15 @@ expect_rc 2 "missing URDF"
 expect_one_line_error "missing URDF"
 run "$AS" calibrate --task pick_cube --episodes 1 --steps 5 --package "$PKG"
 expect_rc 2 "--package without --robot"
+# a robot that is not the Panda the environment drives: refused when it is loaded, naming the file
+sed 's/panda_hand_tcp/tool0/g' "$SRC/configs/robots/panda.urdf" > "$TMP/no_tcp.urdf"
+sed 's/<joint name="panda_joint7" type="revolute">/<joint name="panda_joint7" type="fixed">/' \
+  "$SRC/configs/robots/panda.urdf" > "$TMP/six.urdf"
+run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad_plan" --robot "$TMP/no_tcp.urdf"
+expect_rc 2 "URDF without the TCP link"
+expect_err "no_tcp.urdf: robot.tcp_link: no link named 'panda_hand_tcp'" "URDF without the TCP link"
+run "$AS" run --task pick_cube --split seen --method oracle --episodes 2 --out "$TMP/x" --progress off --robot "$TMP/six.urdf"
+expect_rc 2 "URDF with a 6-joint arm"
+expect_err "six.urdf: robot.arm: the chain to 'panda_hand_tcp' has 6 movable joints, 7 expected" "URDF with a 6-joint arm"
 [ ! -e "$TMP/x" ] || [ -z "$(ls -A "$TMP/x")" ] && ok || bad "bad input wrote results"
 finish

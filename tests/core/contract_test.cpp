@@ -1,4 +1,5 @@
 #include "actionshift/core/contract.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 
 #include <gmock/gmock.h>
@@ -151,7 +152,43 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1],"target":"delta","zeta":1,"alpha":2})",
                 "unknown contract fields: alpha, zeta"},
         BadCase{R"({"frame":"base","permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1]})",
-                "missing contract fields: gripper_inverted, lag, target"}));
+                "missing contract fields: gripper_inverted, lag, target"},
+        // a repeated key: JSON parsers keep one of the two values silently (nlohmann the last)
+        BadCase{R"({"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1.0,1.0,1.0,1.0,1.0,1.0],"sign":[1,1,1,1,1,1],"target":"delta","lag":3})",
+                "contract: lag: duplicate key in one object"}));
+
+TEST(JsonInput, RepeatedKeysAreRefusedPerObjectOnly) {
+  // the same key in two sibling objects, or in an object and its child, is fine
+  EXPECT_NO_THROW(parse_json_input(R"({"a":{"k":1},"b":{"k":2},"k":[{"k":1},{"k":2}]})", "t.json"));
+  EXPECT_THAT([] { parse_json_input(R"({"a":{"k":1},"b":[{"x":1,"k":2,"x":3}]})", "t.json"); },
+              ThrowsMessage<InputError>(HasSubstr("t.json: b[].x: duplicate key in one object")));
+  EXPECT_THAT([] { parse_json_input(R"({"p":{"k":1,"k":1}})", "t.json", "--params"); },
+              ThrowsMessage<InputError>(HasSubstr("t.json: --params.p.k: duplicate key")));
+}
+
+TEST(JsonInput, EchoedInputIsCut) {
+  // an unterminated string is nlohmann's whole "last read" token; a 100 KB key is the field path
+  const auto message = [](const std::string& text) {
+    try {
+      parse_json_input(text, "t.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string unterminated = message("{\"k\": \"" + std::string(100000, 'a'));
+  EXPECT_THAT(unterminated, HasSubstr("t.json: k: not valid JSON: "));
+  EXPECT_THAT(unterminated, HasSubstr("more bytes)"));
+  EXPECT_LT(unterminated.size(), 400u);
+  const std::string key(100000, 'k');
+  const std::string duplicate = message("{\"" + key + "\": 1, \"" + key + "\": 2}");
+  EXPECT_THAT(duplicate, HasSubstr("duplicate key in one object"));
+  EXPECT_LT(duplicate.size(), 400u);
+  // an InputError cuts a field path and a reason built from input, never the source
+  const InputError e(std::string(300, 's'), std::string(5000, 'f'), std::string(5000, 'r'));
+  EXPECT_THAT(std::string(e.what()), HasSubstr(std::string(300, 's') + ": "));
+  EXPECT_LT(std::string(e.what()).size(), 300u + 200u + 2000u + 80u);
+}
 
 TEST(Contract, TryMakeIsTheNonThrowingTwin) {
   ContractFields f;

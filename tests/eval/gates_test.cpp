@@ -49,6 +49,14 @@ TEST(PairedRecords, MismatchedKeysAreErrors) {
   EXPECT_THAT([&] { paired_difference({}, {}); }, ThrowsMessage<InputError>(HasSubstr("no episodes to pair")));
 }
 
+TEST(PairedRecords, PromotionErrorsNameTheCellAndTheMethods) {
+  // gate promote / gate check with one job unfinished: the message says which cell and which methods
+  const auto cand = make_records("push_cube", "seen", "a", {1}, 6, [](int) { return true; });
+  const auto base = make_records("push_cube", "seen", "b", {1}, 5, [](int) { return true; });
+  EXPECT_THAT([&] { promotion_report(concat(cand, base), "a", "b"); },
+              ThrowsMessage<InputError>(HasSubstr("promotion: push_cube/seen: a vs b: episode keys differ: 1 only in candidate")));
+}
+
 TEST(Superiority, NeedsThreeDistinctSeeds) {
   EXPECT_FALSE(superiority_allowed({1, 2}));
   EXPECT_FALSE(superiority_allowed({1, 1, 2}));

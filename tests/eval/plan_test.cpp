@@ -70,6 +70,14 @@ TEST(Experiment, ErrorsNameFileAndField) {
   const std::string base = "name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n";
   EXPECT_NO_THROW(parse_experiment(base, "e.yaml"));
   fails(base + "colour: red\n", "e.yaml:8: colour: unknown key");
+  // yaml-cpp keeps both entries of a repeated key and reads the first: the file is refused instead
+  fails(base + "episodes: 8\n", "e.yaml:8: episodes: duplicate key");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [{name: oracle, name: no_adapt}]\nseeds: [1]\nepisodes: 4\n"
+        "backbone: expert\n",
+        "methods[0].name: duplicate key");
+  fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [{name: entropy_probes, params: {budget: 2, budget: 6}}]\n"
+        "seeds: [1]\nepisodes: 4\nbackbone: expert\n",
+        "methods[0].params.budget: duplicate key");
   fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nbackbone: expert\n",
         "e.yaml: episodes: missing required key");
   fails(base + "rotation_mode: real\n", "rotation_mode: expected \"live\" or \"identity\"");
@@ -145,10 +153,18 @@ TEST(Plan, SingleJobRequestMatchesThePlanEntry) {
 TEST(Plan, ResolverErrorsPropagate) {
   auto ex = parse_experiment(kYaml, "tiny.yaml");
   ex.splits.push_back("missing");
+  // a resolver knows the name it was given; the message names the experiment file and the entry
+  EXPECT_THAT([&] { make_plan(ex, fake_resolver()); },
+              ThrowsMessage<InputError>(HasSubstr("tiny.yaml: splits[2]: ")));
   EXPECT_THAT([&] { make_plan(ex, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("no such split manifest")));
   ex = parse_experiment(kYaml, "tiny.yaml");
   ex.methods.push_back({"telepathy", "{}"});
   EXPECT_THAT([&] { make_plan(ex, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("telepathy: unknown method")));
+  EXPECT_THAT([&] { make_plan(ex, fake_resolver()); }, ThrowsMessage<InputError>(HasSubstr("tiny.yaml: methods[2]: ")));
+  ex = parse_experiment(kYaml, "tiny.yaml");
+  ex.tasks.push_back("pick-cube");
+  EXPECT_THAT([&] { make_plan(ex, fake_resolver()); },
+              ThrowsMessage<InputError>(HasSubstr("tiny.yaml: tasks[2]: task: unknown task 'pick-cube'")));
 }
 
 TEST(Plan, FileRoundTripAndTamperDetection) {

@@ -82,6 +82,8 @@ def test_adapter_errors_are_value_errors():
         actionshift.make_adapter("entropy_probes", task=TASK, pool="reference9", params={"budget": -1})
     with pytest.raises(ValueError, match="params: not a JSON object"):
         actionshift.make_adapter("no_adapt", task=TASK, params="[1, 2]")
+    with pytest.raises(ValueError, match="params.budget: duplicate key"):
+        actionshift.make_adapter("entropy_probes", task=TASK, pool="reference9", params='{"budget": 2, "budget": 6}')
     a = actionshift.make_adapter("no_adapt", task=TASK)
     with pytest.raises(ValueError, match="canonical: must be 7 numbers"):
         a.encode([1, 2], None)

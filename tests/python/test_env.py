@@ -125,6 +125,25 @@ def one_line(excinfo):
     return "\n" not in str(excinfo.value)
 
 
+def test_actions_must_be_real_numbers():
+    # numpy's forcecast turned complex actions into their real part and "0.5" into 0.5
+    env = actionshift.make("pick_cube")
+    env.reset(seed=0)
+    for bad in (np.zeros(7, dtype=complex), ["0.5"] * 7, np.array(["0"] * 7), [object()] * 7):
+        with pytest.raises(ValueError, match="action: must hold real numbers") as e:
+            env.step(bad)
+        assert one_line(e)
+    for good in (np.zeros(7, dtype=np.float32), [0] * 7, np.zeros(7, dtype=np.int8), (0.0,) * 7):
+        env.step(good)
+    envs = actionshift.make_vec("pick_cube", 2)
+    envs.reset(seed=0)
+    with pytest.raises(ValueError, match="actions: must hold real numbers"):
+        envs.step(np.zeros((2, 7), dtype=complex))
+    adapter = actionshift.make_adapter("no_adapt", task="pick_cube")
+    with pytest.raises(ValueError, match="canonical: must hold real numbers"):
+        adapter.encode(["1"] * 7, None)
+
+
 def test_step_before_reset_raises_instead_of_crashing():
     # a fresh env has no robot in its Bullet world until the first reset (this used to segfault)
     env = actionshift.make("push_cube")

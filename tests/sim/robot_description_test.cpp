@@ -211,6 +211,18 @@ TEST(HostileUrdf, PhysicallyInvalidLimitsAndInertiasAreRejected) {
   EXPECT_THAT(rejection(mass), HasSubstr("mass"));
 }
 
+TEST(HostileUrdf, LongMeshNamesAreCutInMessages) {
+  const std::string toy = R"(<robot name="toy"><link name="a"><collision><geometry><mesh filename="NAME"/></geometry></collision></link></robot>)";
+  const auto with_name = [&](const std::string& v) { std::string t = toy; t.replace(t.find("NAME"), 4, v); return t; };
+  const std::string missing = rejection(with_name("meshes/" + std::string(100000, 'm') + ".stl"));
+  EXPECT_THAT(missing, HasSubstr("mesh file not found: '"));
+  EXPECT_THAT(missing, HasSubstr("more bytes)"));
+  EXPECT_LT(missing.size(), 600u);
+  const std::string package = rejection(with_name("package://" + std::string(100000, 'p') + "/a.stl"));
+  EXPECT_THAT(package, HasSubstr("not in the package map (give --package NAME=DIR)"));
+  EXPECT_LT(package.size(), 600u);
+}
+
 TEST(HostileUrdf, DeepXmlAndUnknownMimicAreRejected) {
   std::string deep = "<robot name='x'>";
   for (int i = 0; i < 100000; ++i) deep += "<a>";

@@ -70,7 +70,8 @@ inline std::string quote_input(std::string_view s, char quote = '\'', std::size_
 /// Bad input at a boundary (a file, a field, a command-line value).
 /// `what()` is one line: `<source>: <field>: <reason>`; empty parts are left out, and control
 /// characters or bytes that are not UTF-8 in any part are escaped (printable_input), so a file name,
-/// key or value echoed from the input can never break the line.
+/// key or value echoed from the input can never break the line. The field is cut after 200 bytes and
+/// the reason after 2000.
 class InputError : public std::invalid_argument {
  public:
   InputError(std::string source, std::string field, std::string reason)
@@ -84,13 +85,15 @@ class InputError : public std::invalid_argument {
   const std::string& reason() const noexcept { return reason_; }  ///< what is wrong
 
  private:
+  // the source (a path, bounded by the system) is kept whole; a field path or reason built from a
+  // file's keys and values is cut, so no input can make its error message unbounded
+  static constexpr std::size_t kMaxFieldBytes = 200;
+  static constexpr std::size_t kMaxReasonBytes = 2000;
   static std::string compose(const std::string& s, const std::string& f, const std::string& r) {
-    constexpr auto kWhole = std::string_view::npos;
     std::string out;
-    for (const std::string* part : {&s, &f}) {
-      if (!part->empty()) out += printable_input(*part, kWhole) + ": ";
-    }
-    out += printable_input(r, kWhole);
+    if (!s.empty()) out += printable_input(s, std::string_view::npos) + ": ";
+    if (!f.empty()) out += printable_input(f, kMaxFieldBytes) + ": ";
+    out += printable_input(r, kMaxReasonBytes);
     return out;
   }
   std::string source_, field_, reason_;

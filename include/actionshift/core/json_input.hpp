@@ -32,10 +32,20 @@ inline std::string json_field_path(const std::vector<std::string>& names) {
   return out;
 }
 
-// nlohmann's message without its "[json.exception.<kind>.<id>] " prefix and byte-offset chatter
+// nlohmann's message without its "[json.exception.<kind>.<id>] " prefix and byte-offset chatter;
+// the text it quotes as "last read" (an unterminated string: all of it) is cut to 80 bytes
 inline std::string json_reason(const std::string& what) {
   const auto close = what.find("] ");
-  return close == std::string::npos || what.rfind("[json.exception.", 0) != 0 ? what : what.substr(close + 2);
+  std::string r = close == std::string::npos || what.rfind("[json.exception.", 0) != 0 ? what : what.substr(close + 2);
+  static constexpr std::string_view kLastRead = "last read: '";
+  if (const auto at = r.find(kLastRead); at != std::string::npos) {
+    const auto from = at + kLastRead.size();
+    // the quoted text ends at "'; expected …" if nlohmann names what it expected, else at the end
+    auto to = r.find("'; expected", from);
+    if (to == std::string::npos) to = !r.empty() && r.back() == '\'' ? r.size() - 1 : r.size();
+    if (to > from + 80) r = r.substr(0, from) + printable_input(std::string_view(r).substr(from, to - from), 80) + r.substr(to);
+  }
+  return r;
 }
 
 }  // namespace detail
@@ -50,11 +60,14 @@ inline std::string json_for_message(const nlohmann::json& v, std::size_t max_byt
 /// Parse `text` read from `source`. `field` prefixes the field path in errors (e.g. the name of the
 /// argument or header the text came from). Never recurses on the input's structure.
 /// throws InputError(source, field path, reason) for syntax errors, nesting deeper than
-/// `max_depth`, and numbers outside the range of a double.
+/// `max_depth`, a key repeated within one object, and numbers outside the range of a double.
 inline nlohmann::json parse_json_input(std::string_view text, const std::string& source, const std::string& field = "",
                                        int max_depth = kMaxJsonDepth) {
   std::vector<std::string> names;
   if (!field.empty()) names.push_back(field);
+  // the keys seen so far in each open object, innermost last: a repeated key is refused (nlohmann
+  // would keep the last value silently, so `{"scale": 1, "scale": -1}` would read as -1)
+  std::vector<std::vector<std::string>> open_keys;
   const std::size_t base = names.size();
   const auto at = [&](int depth) { return base + static_cast<std::size_t>(depth > 0 ? depth : 0); };
   const nlohmann::json::parser_callback_t track = [&](int depth, nlohmann::json::parse_event_t event,
@@ -69,12 +82,24 @@ inline nlohmann::json parse_json_input(std::string_view text, const std::string&
         }
         names.resize(at(depth));
         if (event == E::array_start) names.emplace_back("[]");
+        if (event == E::object_start) open_keys.emplace_back();
         break;
-      case E::key:
+      case E::key: {
         names.resize(at(depth - 1));
         names.push_back(parsed.is_string() ? parsed.get<std::string>() : std::string("?"));
+        if (!open_keys.empty() && parsed.is_string()) {
+          std::vector<std::string>& seen = open_keys.back();
+          const std::string& key = parsed.get_ref<const std::string&>();
+          for (const std::string& k : seen)
+            if (k == key) throw InputError(source, printable_input(detail::json_field_path(names), 200), "duplicate key in one object");
+          seen.push_back(key);
+        }
         break;
+      }
       case E::object_end:
+        if (!open_keys.empty()) open_keys.pop_back();
+        names.resize(at(depth));
+        break;
       case E::array_end:
         names.resize(at(depth));
         break;

@@ -135,8 +135,10 @@ struct VerdictChange {
 };
 
 /// Compare two verdict files of the same gate cell by cell (every expected cell, then actual-only
-/// cells). Throws actionshift::InputError if either is not a verdict file or the gates differ.
+/// cells). Throws actionshift::InputError, naming `expected_source` or `actual_source`, if either is
+/// not a verdict file or the gates differ.
 std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, const nlohmann::json& actual,
-                                            const std::string& expected_source = "expected");
+                                            const std::string& expected_source = "expected",
+                                            const std::string& actual_source = "recomputed verdicts");
 
 }  // namespace actionshift::eval
