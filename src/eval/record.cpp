@@ -4,6 +4,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
+#include "actionshift/sim/task.hpp"
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -72,6 +73,11 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
     throw InputError(src, "schema_version", "unsupported schema version (got " + quote_input(r.schema_version, '"') + ", expected \"" + std::string(kRecordSchemaVersion) + "\")");
   if (!is_sha256_hex(r.job_id)) throw InputError(src, "job_id", "expected 64 lowercase hex digits (got " + quote_input(r.job_id, '"') + ")");
   if (!detail::is_token(r.task)) throw InputError(src, "task", "expected a name of [a-z0-9_.-] (got " + quote_input(r.task, '"') + ")");
+  try {
+    (void)sim::parse_task(r.task);  // summaries and gates group by task: a misspelt one would be a cell of its own
+  } catch (const std::invalid_argument&) {
+    throw InputError(src, "task", "not a task of this benchmark (got " + quote_input(r.task, '"') + ")");
+  }
   if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got " + quote_input(r.split, '"') + ")");
   if (!detail::is_token(r.method)) throw InputError(src, "method", "expected a name of [a-z0-9_.-] (got " + quote_input(r.method, '"') + ")");
   if (r.contract_index < 0) throw InputError(src, "contract_index", "must be >= 0");

@@ -94,6 +94,9 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
               ThrowsMessage<InputError>(HasSubstr("safety_flags: duplicate flag")));
   EXPECT_THAT([&] { parse_record_line(with("probe_steps", "51"), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("probe_steps: exceeds steps")));
+  // a well-formed name that is no task would become a summary cell of its own
+  EXPECT_THAT([&] { parse_record_line(with("task", "\"pick_cubes\""), "r.jsonl:2"); },
+              ThrowsMessage<InputError>(HasSubstr("r.jsonl:2: task: not a task of this benchmark (got \"pick_cubes\")")));
   nlohmann::json missing = nlohmann::json::parse(line);
   missing.erase("return");
   EXPECT_THAT([&] { parse_record_line(missing.dump(), "r.jsonl:9"); },
