@@ -131,8 +131,13 @@ std::vector<std::string> manifest_files(const std::vector<std::string>& paths) {
     std::error_code ec;
     if (fs::is_directory(p, ec)) {
       std::vector<std::string> found;
-      for (const auto& e : fs::directory_iterator(p))
-        if (e.is_regular_file() && e.path().extension() == ".json") found.push_back(e.path().string());
+      fs::directory_iterator it(p, ec), end;
+      if (ec) throw InputError(p, "", "cannot list directory: " + ec.message());
+      for (; it != end; it.increment(ec)) {
+        std::error_code type_ec;
+        if (it->is_regular_file(type_ec) && it->path().extension() == ".json") found.push_back(it->path().string());
+      }
+      if (ec) throw InputError(p, "", "cannot list directory: " + ec.message());
       std::sort(found.begin(), found.end());
       if (found.empty()) throw InputError(p, "", "directory holds no *.json manifest");
       files.insert(files.end(), found.begin(), found.end());

@@ -12,6 +12,7 @@
 
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/eval/runner.hpp"
+#include "actionshift/sim/env.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -43,6 +44,18 @@ const CLI::Validator kNotNan(
       return std::isnan(v) ? "must be a number (got '" + s + "')" : std::string();
     },
     "");
+
+// every command that builds an environment names a fidelity profile: refused while parsing, as a
+// usage error, rather than by whichever layer first builds a model
+const CLI::Validator kProfile(
+    [](std::string& s) -> std::string {
+      const auto names = sim::profile_names();
+      if (std::find(names.begin(), names.end(), s) != names.end()) return {};
+      std::string known;
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+      return "unknown fidelity profile " + quote_input(s) + " (known: " + known + ")";
+    },
+    "PROFILE");
 
 }  // namespace
 
@@ -118,7 +131,7 @@ int main(int argc, char** argv) {
              "on one thread and on all threads");
   bench_env->add_option("--task", bench_env_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")
       ->capture_default_str();
-  bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
+  bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->check(kProfile)->capture_default_str();
   bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
   bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
       ->check(CLI::Range(0, 1024))
@@ -146,7 +159,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_adapt->add_option("--task", bench_adapt_o.task, "Task whose built-in response calibration is the response model")
       ->capture_default_str();
-  bench_adapt->add_option("--profile", bench_adapt_o.profile, "Simulator fidelity profile of that calibration: maniskill or ideal")
+  bench_adapt->add_option("--profile", bench_adapt_o.profile, "Simulator fidelity profile of that calibration: maniskill or ideal")->check(kProfile)
       ->capture_default_str();
   bench_adapt->add_option("--episodes", bench_adapt_o.episodes, "Episodes per repetition")->capture_default_str()->check(CLI::PositiveNumber);
   bench_adapt->add_option("--steps", bench_adapt_o.steps, "Control steps per episode")->capture_default_str()->check(CLI::PositiveNumber);
@@ -173,7 +186,7 @@ int main(int argc, char** argv) {
       ->excludes(st_demo);
   st->add_option("--expected", st_o.expected, "The wiring the policy assumes")->capture_default_str();
   st->add_flag("--sim", st_o.sim, "Probe the Bullet environment of --task instead of the synthetic stand-in");
-  st->add_option("--profile", st_o.profile, "--sim: simulator fidelity profile: maniskill or ideal (docs/sim.md)")
+  st->add_option("--profile", st_o.profile, "--sim: simulator fidelity profile: maniskill or ideal (docs/sim.md)")->check(kProfile)
       ->capture_default_str();
   st->add_option("--calibration", st_o.calibration, "--sim: response calibration JSON (default: the task's built-in one)");
   st->add_option("--frame-rotation", st_o.frame_rotation, "--sim: live (TCP orientation) or identity")->capture_default_str();
@@ -204,7 +217,7 @@ int main(int argc, char** argv) {
       "bc", "Train the MLP backbone of a task by DAgger from the scripted expert (Eigen, Adam; seeded and\n"
             "deterministic). Writes configs/backbones/<task>.mlp[-delay-aware].asmlp (docs/backbones.md).");
   bc->add_option("--task", train_o.task, "pick_cube, push_cube, pull_cube, stack_cube")->required();
-  bc->add_option("--profile", train_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")
+  bc->add_option("--profile", train_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->check(kProfile)
       ->capture_default_str();
   bc->add_flag("--delay-aware", train_o.delay_aware, "Append the last 4 actions to the input; train under random lag {0,1,2,4}");
   bc->add_option("--seed", train_o.seed, "Seed")->check(kSeed)->capture_default_str();
@@ -226,7 +239,7 @@ int main(int argc, char** argv) {
   tid->add_option("--kind", tid_o.kind, "osi (passive window), probe_osi (6 fixed pulses first) or recurrent_osi (Elman cell)")
       ->required();
   tid->add_option("--task", tid_o.task, "Task of the rollouts")->capture_default_str();
-  tid->add_option("--profile", tid_o.profile, "Simulator fidelity profile of the rollouts")->capture_default_str();
+  tid->add_option("--profile", tid_o.profile, "Simulator fidelity profile of the rollouts")->check(kProfile)->capture_default_str();
   tid->add_option("--seed", tid_o.seed, "Seed (weights init, rollouts, minibatches)")->check(kSeed)->capture_default_str();
   tid->add_option("--excitation", tid_o.excitation,
                   "expert: the scripted expert passed through (what a passive identifier sees); random: uniform raw\n"
@@ -249,7 +262,7 @@ int main(int argc, char** argv) {
              "whatever the thread count. Writes the actor mean as configs/backbones/<task>.ppo.asmlp (backbone\n"
              "`ppo`; checkpointed after every evaluation) and a training curve, one JSON line per iteration.");
   ppo->add_option("--task", ppo_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
-  ppo->add_option("--profile", ppo_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->capture_default_str();
+  ppo->add_option("--profile", ppo_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->check(kProfile)->capture_default_str();
   ppo->add_option("--seed", ppo_o.seed, "Seed (initialisation, episodes, exploration noise, minibatches)")->check(kSeed)->capture_default_str();
   ppo->add_option("--total-steps", ppo_o.total_steps, "Environment steps of the run")->capture_default_str();
   ppo->add_option("--envs", ppo_o.envs, "Parallel environments")->capture_default_str();
@@ -293,7 +306,7 @@ int main(int argc, char** argv) {
                "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<file>, external:<command>.");
   gate0->add_option("--backbone", gate0_o.backbone, "Backbone")->capture_default_str();
   gate0->add_option("--task", gate0_o.task, "Task")->required();
-  gate0->add_option("--profile", gate0_o.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")
+  gate0->add_option("--profile", gate0_o.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")->check(kProfile)
       ->capture_default_str();
   gate0->add_option("--episodes", gate0_o.episodes, "Episodes (each run unwrapped and identity-wrapped)")->capture_default_str();
   gate0->add_option("--seed", gate0_o.seed, "Experimental seed")->check(kSeed)->capture_default_str();
@@ -346,7 +359,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->add_option("--profile", run_o.request.profile,
                   "Simulator fidelity profile: maniskill (one-step IK, PD drives with inertia, as ManiSkill) or\n"
-                  "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")
+                  "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")->check(kProfile)
       ->capture_default_str();
   run->add_option("--obs-noise", run_o.request.obs_noise,
                   "Observation (sensor) noise, OFF by default: sigma of Gaussian noise on the observed TCP pose, in\n"
@@ -459,7 +472,7 @@ int main(int argc, char** argv) {
       "calibrate", "Measure each pose channel's response gain, noise and R^2 on the unwrapped environment with\n"
                    "random actions (the likelihood of the belief adapters); prints the table, --out writes the JSON.");
   calibrate->add_option("--task", cal_o.task, "Task")->required();
-  calibrate->add_option("--profile", cal_o.profile, "Simulator fidelity profile: maniskill or ideal")->capture_default_str();
+  calibrate->add_option("--profile", cal_o.profile, "Simulator fidelity profile: maniskill or ideal")->check(kProfile)->capture_default_str();
   calibrate->add_option("--protocol", cal_o.protocol,
                         "maniskill_walk (the public reference implementation's, as it runs in ManiSkill: 8 random\n"
                         "walks of 64 steps, truncated and reset at the task's 50-step horizon as ManiSkill's vector\n"
@@ -502,7 +515,7 @@ int main(int argc, char** argv) {
   render->add_option("--backbone", render_o.request.backbone, "Frozen policy")->capture_default_str();
   render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");
   render->add_option("--rotation-mode", render_o.request.rotation_mode, "live or identity")->capture_default_str();
-  render->add_option("--profile", render_o.request.profile, "Simulator fidelity profile: maniskill or ideal (as for run)")
+  render->add_option("--profile", render_o.request.profile, "Simulator fidelity profile: maniskill or ideal (as for run)")->check(kProfile)
       ->capture_default_str();
   render->add_option("--obs-noise", render_o.request.obs_noise, "Observation-noise sigma of the job (as for run; 0 = off)")
       ->capture_default_str();
