@@ -223,7 +223,7 @@ int run_validate(const ValidateOptions& o) {
   std::cout << "\n";
   if (failed) std::cout << failed << " check(s) FAILED";
   else std::cout << "all checks passed";
-  std::cout << " over " << loaded.size() << " manifests\n";
+  std::cout << " over " << counted(loaded.size(), "manifest") << "\n";
   return failed ? kCheckFailed : kOk;
 }
 

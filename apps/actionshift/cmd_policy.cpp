@@ -243,7 +243,7 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     err << "train ppo: " << o.task << (o.delay_aware ? " (delay-aware)" : "") << ", layers "
         << sim::observation_layout(p.task).size() + (o.delay_aware ? policy::kHistoryLength * kActionDim : 0) << "-" << o.hidden << "-7 (actor and critic), "
         << iterations << " iterations x " << o.envs << " envs x " << o.rollout_steps << " steps = " << iterations * per_iter
-        << " env steps, seed " << o.seed << ", " << policy::resolve_threads(o.threads) << " threads\n";
+        << " env steps, seed " << o.seed << ", " << counted(static_cast<std::size_t>(policy::resolve_threads(o.threads)), "thread") << "\n";
     double last_eval = -1.0, last_eval_return = 0.0, best_eval = -1.0;
     std::int64_t best_steps = 0;
     const std::string best_path = stem + ".best.asmlp";

@@ -82,14 +82,14 @@ int run_render(const RenderOptions& o) {
     const Format format = check_output(o.out);
     if (o.delay_cs < 1 || o.delay_cs > 1000) throw InputError("command line", "--delay", "must be in 1..1000");
     const auto [w, h] = parse_size(o.size);
-    eval::JobRequest q = o.request;
-    q.method.params = o.method_params;
-    const eval::JobSpec job = eval::resolve_job(q, eval::default_resolver());
+    eval::JobSpec job;
     render::EpisodeRenderOptions ro;
+    ro.episode.external.step_timeout_s = o.step_timeout_s;
+    resolve_cli_job(o.job, job, ro.episode);
     ro.width = w;
     ro.height = h;
     ro.camera = render::parse_camera(o.camera, sim::parse_task(job.task));
-    ro.overlay = o.overlay;
+    ro.overlay = !o.no_overlay;
     ro.label = o.label;
     ro.clean = o.clean;
     if (o.contract < 0 || o.contract >= job.split.contracts)
@@ -150,7 +150,7 @@ int run_montage(const MontageOptions& o) {
 int run_report(const ReportOptions& o) {
   try {
     const render::ReportResult r = render::write_report(o.results_dir, o.out_dir);
-    std::cout << "report: " << r.html_path << " and " << r.markdown_path << " (" << r.figures.size() << " figures, "
+    std::cout << "report: " << r.html_path << " and " << r.markdown_path << " (" << counted(r.figures.size(), "figure") << ", "
               << r.summaries << " job summaries)\n";
     return kOk;
   } catch (const std::exception& e) {

@@ -3,6 +3,7 @@
 // `actionshift report` (HTML + Markdown page with figures): plain functions, no CLI11 here.
 
 #include "actionshift/eval/plan.hpp"
+#include "cmd_run.hpp"
 
 #include <cstdint>
 #include <string>
@@ -12,10 +13,11 @@ namespace actionshift::cli {
 
 // `actionshift render --task T --split S --method M [--contract I] [--episode E] [--camera C]
 //  [--size WxH] [--frame K] [--clean] [--label L] [--no-overlay] --out FILE.gif|png`
-// plus the job options of `run` (--seed, --episodes, --backbone, --pool, --params, --rotation-mode).
+// plus every job option of `run` (--seed, --episodes, --backbone, --pool, --params, --rotation-mode,
+// --profile, --obs-noise, --calibration, --robot/--package, --policy-files) and --step-timeout.
 struct RenderOptions {
-  eval::JobRequest request;         // the job, resolved exactly as `run` resolves it
-  std::string method_params{"{}"};  // --params
+  CliJobOptions job;                // the job, resolved exactly as `run` resolves it
+  double step_timeout_s{10.0};      // --step-timeout S: external policy request/reply bound
   std::int64_t contract{0};         // --contract I: contract index in the split
   std::int64_t episode{0};          // --episode E: the contract's E-th episode (job episode E * contracts + I)
   std::string camera{"default"};    // --camera
@@ -23,7 +25,7 @@ struct RenderOptions {
   int frame{-1};                    // --frame K (PNG only): the state after K steps; -1: the last
   bool clean{false};                // --clean: identity contract, same episode seed
   std::string label;                // --label: overlay title (default: the method, or "clean")
-  bool overlay{true};               // --no-overlay
+  bool no_overlay{false};           // --no-overlay
   int delay_cs{10};                 // --delay: GIF frame time in 1/100 s
   std::string out;                  // --out FILE.gif|FILE.png
 };

@@ -66,13 +66,34 @@ adapt::ResponseCalibration load_calibration_file(const std::string& path) {
 
 }  // namespace
 
+void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options) {
+  check_obs_noise(o.request.obs_noise);
+  eval::JobRequest q = o.request;
+  q.method.params = o.method_params;
+  job = eval::resolve_job(q, eval::default_resolver());
+  job.robot = cli_robot_ref(o.robot);
+  job.policy_files = cli_policy_files(o.policy_files, job.backbone.name);
+  if (!o.calibration.empty()) {
+    if (!job.calibration_sha256)
+      throw InputError("command line", "--calibration", "method " + job.method + " uses no response calibration");
+    adapt::ResponseCalibration cal = load_calibration_file(o.calibration);
+    if (cal.task != job.task) throw InputError(o.calibration, "task", "is " + cal.task + ", not the job's " + job.task);
+    const std::string base = cal.profile.substr(0, cal.profile.find('['));
+    if (base != job.profile)
+      throw InputError(o.calibration, "profile", "was measured on " + cal.profile + ", not on the job's profile " + job.profile);
+    job.calibration_sha256 = cal.sha256();
+    options.calibration = std::move(cal);
+    options.calibration_source = o.calibration;
+  }
+}
+
 int run_run(const RunCliOptions& o) {
   eval::EpisodeFnOptions options;
   options.external.step_timeout_s = o.run.step_timeout_s;
   if (!o.run.plan_file.empty()) {
     const EpisodeFnFactory factory = [options](const eval::JobSpec& job) { return eval::make_episode_fn(job, options); };
-    if (!o.robot.urdf.empty() || !o.robot.packages.empty() || !o.policy_files.empty() || !o.calibration.empty() ||
-        o.request.obs_noise != 0.0) {
+    if (!o.job.robot.urdf.empty() || !o.job.robot.packages.empty() || !o.job.policy_files.empty() || !o.job.calibration.empty() ||
+        o.job.request.obs_noise != 0.0) {
       std::cerr << "actionshift: error: --plan: " << o.run.plan_file
                 << ": a plan's jobs carry their robot and policy files (give --robot/--policy-files to `actionshift plan`);"
                    " --calibration and --obs-noise apply to a single job only\n";
@@ -81,33 +102,9 @@ int run_run(const RunCliOptions& o) {
     return run_plan_jobs(o.run, factory);
   }
   try {
-    check_obs_noise(o.request.obs_noise);
-    eval::JobRequest q = o.request;
-    q.method.params = o.method_params;
-    eval::JobSpec job = eval::resolve_job(q, eval::default_resolver());
-    job.robot = cli_robot_ref(o.robot);
-    job.policy_files = cli_policy_files(o.policy_files, job.backbone.name);
-    if (!o.calibration.empty()) {
-      if (!job.calibration_sha256)
-        throw InputError("command line", "--calibration", "method " + job.method + " uses no response calibration");
-      adapt::ResponseCalibration cal = load_calibration_file(o.calibration);
-      if (cal.task != job.task) throw InputError(o.calibration, "task", "is " + cal.task + ", not the job's " + job.task);
-      const std::string base = cal.profile.substr(0, cal.profile.find('['));
-      if (base != job.profile)
-        throw InputError(o.calibration, "profile", "was measured on " + cal.profile + ", not on the job's profile " + job.profile);
-      job.calibration_sha256 = cal.sha256();
-      options.calibration = std::move(cal);
-    }
-    const std::string calibration_file = o.calibration;
-    const EpisodeFnFactory factory = [options, calibration_file](const eval::JobSpec& j) {
-      try {
-        return eval::make_episode_fn(j, options);
-      } catch (const InputError& e) {
-        // the episode function checks a given calibration against the task; the file's name is known here
-        if (e.source() == "calibration" && !calibration_file.empty()) throw InputError(calibration_file, e.field(), e.reason());
-        throw;
-      }
-    };
+    eval::JobSpec job;
+    resolve_cli_job(o.job, job, options);
+    const EpisodeFnFactory factory = [options](const eval::JobSpec& j) { return eval::make_episode_fn(j, options); };
     return run_one_job(job, o.run, factory);
   } catch (const eval::Interrupted&) {
     throw;  // not an error: main says where the job stopped (exit 130)

@@ -5,6 +5,7 @@
 #include "cmd_eval.hpp"
 #include "commands.hpp"
 
+#include "actionshift/eval/experiment.hpp"
 #include "actionshift/sim/robot_source.hpp"
 
 #include <cstdint>
@@ -16,13 +17,21 @@ namespace actionshift::cli {
 // `actionshift run --task T --split S --method M --seed X [--episodes N] [--backbone B] [--pool P]
 //  [--params JSON] [--rotation-mode live|identity] --out DIR`  or  `actionshift run --plan FILE
 //  [--job-index I] --out DIR`; both with [--threads N] [--fsync] [--progress MODE].
-struct RunCliOptions {
-  eval::JobRequest request;        // single job (ignored with --plan)
+// The options that name one job, shared by `run` and `render` (which must reach the same job id).
+struct CliJobOptions {
+  eval::JobRequest request;        // --task --split --method --seed --episodes --backbone --pool ...
   std::string method_params{"{}"}; // --params: JSON object of method parameters
-  RunPlanOptions run;              // plan_file, job_index, out_dir, threads, fsync, progress
   RobotOptions robot;              // --robot/--package (single job; a plan carries its own)
   std::vector<std::string> policy_files;  // --policy-files: files of an external policy (content hashed into the id)
   std::string calibration;         // --calibration: response calibration file instead of the built-in one
+};
+// The job these options name, and the run-time options of its episode function (the calibration
+// file, read and checked against the job's task and profile). Throws actionshift::InputError.
+void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options);
+
+struct RunCliOptions {
+  CliJobOptions job;               // single job (ignored with --plan)
+  RunPlanOptions run;              // plan_file, job_index, out_dir, threads, fsync, progress
 };
 int run_run(const RunCliOptions& o);
 

@@ -30,10 +30,6 @@
 #include <sstream>
 #include <vector>
 
-namespace actionshift::embedded {
-extern const std::string_view selftest_sim_misspec;  // configs/selftest/sim_misspec.json
-}
-
 namespace actionshift::cli {
 
 namespace {
@@ -230,9 +226,9 @@ int run(const SelftestOptions& o) {
     so.misspec_ratio = *o.misspec_ratio;
   } else if (!o.sim) {
     so.misspec_ratio = kSyntheticMisspecRatio;
-  } else if (const auto calibrated = calibrated_sim_misspec_ratio(o.task, "delta")) {
+  } else if (const auto calibrated = data::builtin_selftest_misspec_ratio(o.task, "delta")) {
     so.misspec_ratio = *calibrated;
-    so.misspec_ratio_absolute = calibrated_sim_misspec_ratio(o.task, "absolute");
+    so.misspec_ratio_absolute = data::builtin_selftest_misspec_ratio(o.task, "absolute");
     misspec_source = "calibrated on the simulator's residuals";
   } else {
     so.misspec_ratio = kUncalibratedSimMisspecRatio;
@@ -321,20 +317,6 @@ Contract resolve_contract_arg(const std::string& arg, const std::string& option)
   }
 }
 
-
-std::optional<double> calibrated_sim_misspec_ratio(const std::string& task, const std::string& target_class) {
-  const std::string src = "configs/selftest/sim_misspec.json";
-  const nlohmann::json all = parse_json_input(embedded::selftest_sim_misspec, src);
-  if (!all.is_object() || !all.contains(task) || !all.at(task).is_object() || !all.at(task).contains(target_class))
-    return std::nullopt;
-  const std::string field = task + "." + target_class + ".misspec_ratio";
-  const nlohmann::json& entry = all.at(task).at(target_class);
-  if (!entry.is_object() || !entry.contains("misspec_ratio") || !entry.at("misspec_ratio").is_number())
-    throw InputError(src, field, "missing or not a number");
-  const double r = entry.at("misspec_ratio").get<double>();
-  if (!(r > 0.0) || !std::isfinite(r)) throw InputError(src, field, "must be finite and positive");
-  return r;
-}
 
 int run_selftest(const SelftestOptions& o) {
   try {

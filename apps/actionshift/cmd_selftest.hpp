@@ -53,11 +53,6 @@ inline constexpr double kUncalibratedSimMisspecRatio = 4.0;
 inline constexpr int kMisspecCalibrationSeeds = 8;
 inline constexpr double kMisspecCalibrationMargin = 1.5;
 
-/// The calibrated --sim misspecification threshold of `task` for MAP wirings of `target_class`
-/// ("delta" or "absolute") from the embedded configs/selftest/sim_misspec.json, or nullopt if the
-/// task has none. Throws InputError for a malformed entry.
-std::optional<double> calibrated_sim_misspec_ratio(const std::string& task, const std::string& target_class);
-
 /// Runs the self-test and prints the report (text or JSON) on stdout. Returns 0/1/2 by verdict, 3 for
 /// bad input (one "actionshift: error: ..." line on stderr).
 int run_selftest(const SelftestOptions& o);

@@ -17,6 +17,11 @@ enum ExitStatus : int {
   kInterrupted = 130,
 };
 
+/// "1 manifest", "3 manifests": a count and its noun for messages (regular plurals only).
+inline std::string counted(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 /// `--robot URDF [--package NAME=DIR]...` of every command that builds an environment: another robot
 /// description than the embedded Panda (loaded by cmd_robot.cpp; its content hash enters job ids).
 struct RobotOptions {

@@ -23,6 +23,7 @@
 #include <functional>
 #include <iostream>
 #include <string_view>
+#include <vector>
 
 using namespace actionshift;
 
@@ -57,6 +58,63 @@ const CLI::Validator kProfile(
     },
     "PROFILE");
 
+// Levenshtein distance, for "did you mean" (command names are a few bytes)
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// CLI11 answers a misspelt command (`summarise`, `gate chek`) with "A subcommand is required":
+// the words before the first option are walked through the command tree here, and the first that
+// names no command is reported with the nearest command's name
+std::string unknown_command(CLI::App& app, int argc, char** argv) {
+  CLI::App* at = &app;
+  std::string path = "actionshift";
+  // `actionshift gate` (or `gate --results R`) without check/promote: name the commands it has
+  const auto needs_command = [&]() -> std::string {
+    const std::vector<CLI::App*> subs = at->get_subcommands([](CLI::App*) { return true; });
+    if (at == &app || subs.empty()) return {};
+    std::string names;
+    for (const CLI::App* sub : subs) names += (names.empty() ? "" : ", ") + sub->get_name();
+    return path + " needs a command: " + names;
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view word = argv[i];
+    if (word == "-h" || word == "--help" || word == "--version") return {};
+    if (word.empty() || word.front() == '-') {
+      for (int k = i + 1; k < argc; ++k)
+        if (std::string_view(argv[k]) == "-h" || std::string_view(argv[k]) == "--help") return {};
+      return needs_command();
+    }
+    const std::vector<CLI::App*> subs = at->get_subcommands([](CLI::App*) { return true; });
+    if (subs.empty()) return {};  // a command's positional arguments
+    CLI::App* next = nullptr;
+    const CLI::App* nearest = nullptr;
+    std::size_t best = 3;  // suggest only names within two edits
+    for (CLI::App* sub : subs) {
+      if (sub->get_name() == word) next = sub;
+      const std::size_t d = edit_distance(word.substr(0, 64), sub->get_name());
+      if (d < best) best = d, nearest = sub;
+    }
+    if (next == nullptr)
+      return "unknown command " + quote_input(word) + " for " + path +
+             (nearest ? " (did you mean '" + nearest->get_name() + "'?)" : std::string());
+    at = next;
+    path += " " + std::string(word);
+  }
+  return needs_command();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,15 +125,59 @@ int main(int argc, char** argv) {
       "actionshift"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("actionshift ") + ACTIONSHIFT_VERSION);
-  app.footer("Exit codes: 0 ok, 1 a check or gate failed, 2 bad input or usage.");
+  app.footer("Exit codes: 0 ok, 1 a check or gate failed, 2 bad input or usage, 130 a job stopped by Ctrl-C or SIGTERM\n"
+             "(re-run the same command to resume). selftest: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input.");
   std::function<int()> action;
   // --robot URDF [--package NAME=DIR]... on every command that builds an environment
-  const auto add_robot_options = [](CLI::App* cmd, cli::RobotOptions& r) {
+  // (`makes_jobs`: run and plan, whose job ids hash the description)
+  const auto add_robot_options = [](CLI::App* cmd, cli::RobotOptions& r, bool makes_jobs = false) {
     cmd->add_option("--robot", r.urdf,
-                    "Robot description (URDF; meshes through assimp) instead of the embedded Panda; its content hash\n"
-                    "(URDF + collision meshes) enters the job id")
+                    makes_jobs ? "Robot description (URDF; meshes through assimp) instead of the embedded Panda; its content hash\n"
+                                 "(URDF + collision meshes) enters the job id"
+                               : "Robot description (URDF; meshes through assimp) instead of the embedded Panda: a 7-joint arm\n"
+                                 "to link panda_hand_tcp with finger joints panda_finger_joint1/2")
         ->check(CLI::Validator([](std::string& v) { return v.empty() ? std::string("must name a URDF file") : std::string(); }, ""));
     cmd->add_option("--package", r.packages, "NAME=DIR: resolve package://NAME/... in --robot (repeatable)");
+  };
+
+  // the options that name one job: `run` and `render` share them, so a render reaches the run's job id
+  std::string method_list;  // the registry's names, so the help cannot fall behind it
+  for (const std::string& m : adapt::method_names()) method_list += (method_list.empty() ? "" : ", ") + m;
+  const auto add_job_options = [&](CLI::App* cmd, cli::CliJobOptions& j, bool required) {
+    auto* task = cmd->add_option("--task", j.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
+    auto* split = cmd->add_option("--split", j.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
+    auto* method = cmd->add_option("--method", j.request.method.name, "Adapter method (docs/adapters.md): " + method_list);
+    if (required) {
+      task->required();
+      split->required();
+      method->required();
+    }
+    cmd->add_option("--params", j.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
+        ->capture_default_str();
+    cmd->add_option("--seed", j.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
+    cmd->add_option("--episodes", j.request.episodes, "Episodes (dealt round-robin over the split's contracts)")
+        ->capture_default_str();
+    cmd->add_option("--backbone", j.request.backbone, "Frozen policy: expert, mlp, external:<command>, ...")
+        ->capture_default_str();
+    cmd->add_option("--pool", j.request.pool, "Declared pool for pool-belief methods: reference9, full or a file");
+    cmd->add_option("--rotation-mode", j.request.rotation_mode, "Tool-frame rotation: live (TCP) or identity")
+        ->capture_default_str();
+    cmd->add_option("--profile", j.request.profile,
+                    "Simulator fidelity profile: maniskill (one-step IK, PD drives with inertia, as ManiSkill) or\n"
+                    "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")->check(kProfile)
+        ->capture_default_str();
+    cmd->add_option("--obs-noise", j.request.obs_noise,
+                    "Observation (sensor) noise, OFF by default: sigma of Gaussian noise on the observed TCP pose, in\n"
+                    "metres per position coordinate and radians per rotation-vector component (0..0.1), drawn per\n"
+                    "episode; seen by policy and adapter alike; part of the job id when non-zero (docs/sim.md 6.1)")
+        ->capture_default_str();
+    cmd->add_option("--calibration", j.calibration,
+                    "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
+                    "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");
+    add_robot_options(cmd, j.robot, /*makes_jobs=*/true);
+    cmd->add_option("--policy-files", j.policy_files,
+                    "Files of an external:<command> backbone (script, weights, config): their content hash enters the\n"
+                    "job id, so editing the policy makes a new job instead of reusing old results");
   };
 
   // ---- validate
@@ -178,6 +280,7 @@ int main(int argc, char** argv) {
       "and answer PASS, MISMATCH (with the diff in words) or INCONCLUSIVE (abstain). Contract arguments: a\n"
       "library name, MANIFEST:INDEX (e.g. reference_seen:0), a file with contract JSON, or inline JSON.\n"
       "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
+  st->footer("Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input or usage.");
   st->add_option("--task", st_o.task, "Task (with --sim: pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side)")
       ->capture_default_str();
   auto* st_demo = st->add_option("--demo", st_o.demo,
@@ -303,7 +406,7 @@ int main(int argc, char** argv) {
   auto* gate0 = app.add_subcommand(
       "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"
                "parity (identity-wrapped vs unwrapped, same initial states); decision advance or exclude (exit 1).\n"
-               "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, mlp:<file>, external:<command>.");
+               "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<file>, external:<command>.");
   gate0->add_option("--backbone", gate0_o.backbone, "Backbone")->capture_default_str();
   gate0->add_option("--task", gate0_o.task, "Task")->required();
   gate0->add_option("--profile", gate0_o.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")->check(kProfile)
@@ -342,33 +445,7 @@ int main(int argc, char** argv) {
       "id is the SHA-256 of everything that determines the episodes; a finished job is a no-op and a killed\n"
       "one resumes. Ctrl-C or SIGTERM stops it after the episodes already finished (exit 130; a second\n"
       "signal ends it at once). Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
-  run->add_option("--task", run_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
-  run->add_option("--split", run_o.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
-  std::string method_list;  // the registry's names, so the help cannot fall behind it
-  for (const std::string& m : adapt::method_names()) method_list += (method_list.empty() ? "" : ", ") + m;
-  run->add_option("--method", run_o.request.method.name, "Adapter method (docs/adapters.md): " + method_list);
-  run->add_option("--params", run_o.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
-      ->capture_default_str();
-  run->add_option("--seed", run_o.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
-  run->add_option("--episodes", run_o.request.episodes, "Episodes (dealt round-robin over the split's contracts)")
-      ->capture_default_str();
-  run->add_option("--backbone", run_o.request.backbone, "Frozen policy: expert, mlp, external:<command>, ...")
-      ->capture_default_str();
-  run->add_option("--pool", run_o.request.pool, "Declared pool for pool-belief methods: reference9, full or a file");
-  run->add_option("--rotation-mode", run_o.request.rotation_mode, "Tool-frame rotation: live (TCP) or identity")
-      ->capture_default_str();
-  run->add_option("--profile", run_o.request.profile,
-                  "Simulator fidelity profile: maniskill (one-step IK, PD drives with inertia, as ManiSkill) or\n"
-                  "ideal (converged IK, first-order servo); part of the job id (docs/sim.md)")->check(kProfile)
-      ->capture_default_str();
-  run->add_option("--obs-noise", run_o.request.obs_noise,
-                  "Observation (sensor) noise, OFF by default: sigma of Gaussian noise on the observed TCP pose, in\n"
-                  "metres per position coordinate and radians per rotation-vector component (0..0.1), drawn per\n"
-                  "episode; seen by policy and adapter alike; part of the job id when non-zero (docs/sim.md 6.1)")
-      ->capture_default_str();
-  run->add_option("--calibration", run_o.calibration,
-                  "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
-                  "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");
+  add_job_options(run, run_o.job, /*required=*/false);
   run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
   run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)")
       ->check(CLI::Validator(
@@ -377,10 +454,6 @@ int main(int argc, char** argv) {
   run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores)")->capture_default_str();
   run->add_flag("--fsync", run_o.run.fsync, "fsync after every record");
   run->add_option("--progress", run_o.run.progress, "auto, bar, lines or off")->capture_default_str();
-  add_robot_options(run, run_o.robot);
-  run->add_option("--policy-files", run_o.policy_files,
-                  "Files of an external:<command> backbone (script, weights, config): their content hash enters the\n"
-                  "job id, so editing the policy makes a new job instead of reusing old results");
   run->add_option("--step-timeout", run_o.run.step_timeout_s,
                   "Seconds an external:<command> backbone may take to read one request and to reply to it\n"
                   "(a process that overruns, floods replies or dies ends the job with an error)")
@@ -390,7 +463,7 @@ int main(int argc, char** argv) {
     action = [&] {
       if (run_job_index >= 0) run_o.run.job_index = run_job_index;
       if (run_o.run.plan_file.empty() &&
-          (run_o.request.task.empty() || run_o.request.split.empty() || run_o.request.method.name.empty())) {
+          (run_o.job.request.task.empty() || run_o.job.request.split.empty() || run_o.job.request.method.name.empty())) {
         std::cerr << "actionshift: error: run needs --task, --split and --method, or --plan (see --help)\n";
         return static_cast<int>(cli::kBadInput);
       }
@@ -422,7 +495,7 @@ int main(int argc, char** argv) {
   plan->add_option("--max-array-size", plan_o.max_array_size,
                    "Tasks per array (default: MaxArraySize from `scontrol show config`, else Slurm's default 1001)");
   cli::RobotOptions plan_robot;
-  add_robot_options(plan, plan_robot);
+  add_robot_options(plan, plan_robot, /*makes_jobs=*/true);
   std::vector<std::string> plan_policy_files;
   plan->add_option("--policy-files", plan_policy_files,
                    "Files of an external:<command> backbone (script, weights); their content hash enters every job id");
@@ -506,18 +579,9 @@ int main(int argc, char** argv) {
       "seed, initial state and outcome as that episode's JSONL record, which is printed as one JSON line.\n"
       "Writes an animated GIF (every step) or a PNG (one frame) with an overlay of the step, the phase\n"
       "(reset / probe / act) and success. Episode E of contract I is the job's episode E * contracts + I.");
-  render->add_option("--task", render_o.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
-  render->add_option("--split", render_o.request.split, "Split manifest: a built-in name or a file")->required();
-  render->add_option("--method", render_o.request.method.name, "Method (as for run)")->required();
-  render->add_option("--params", render_o.method_params, "Method parameters as a JSON object")->capture_default_str();
-  render->add_option("--seed", render_o.request.seed, "Experimental seed of the job")->check(kSeed)->capture_default_str();
-  render->add_option("--episodes", render_o.request.episodes, "Episodes of the job (part of its id)")->capture_default_str();
-  render->add_option("--backbone", render_o.request.backbone, "Frozen policy")->capture_default_str();
-  render->add_option("--pool", render_o.request.pool, "Declared pool for pool-belief methods");
-  render->add_option("--rotation-mode", render_o.request.rotation_mode, "live or identity")->capture_default_str();
-  render->add_option("--profile", render_o.request.profile, "Simulator fidelity profile: maniskill or ideal (as for run)")->check(kProfile)
-      ->capture_default_str();
-  render->add_option("--obs-noise", render_o.request.obs_noise, "Observation-noise sigma of the job (as for run; 0 = off)")
+  add_job_options(render, render_o.job, /*required=*/true);
+  render->add_option("--step-timeout", render_o.step_timeout_s, "Seconds an external:<command> backbone may take per step (as for run)")
+      ->check(CLI::Range(0.001, 86400.0) & kNotNan)
       ->capture_default_str();
   render->add_option("--contract", render_o.contract, "Contract index in the split")->capture_default_str();
   render->add_option("--episode", render_o.episode, "The contract's episode (0 = its first)")->capture_default_str();
@@ -530,7 +594,7 @@ int main(int argc, char** argv) {
   render->add_option("--delay", render_o.delay_cs, "GIF: hundredths of a second per frame")->capture_default_str();
   render->add_flag("--clean", render_o.clean, "Same episode seed with the identity contract (the clean reference panel)");
   render->add_option("--label", render_o.label, "Overlay title (default: the method, or clean)");
-  render->add_flag("!--no-overlay", render_o.overlay, "No overlay");
+  render->add_flag("--no-overlay", render_o.no_overlay, "No overlay");
   render->add_option("--out", render_o.out, "Output FILE.gif or FILE.png")->required();
   render->callback([&] { action = [&] { return cli::run_render(render_o); }; });
 
@@ -553,6 +617,10 @@ int main(int argc, char** argv) {
   report->add_option("--out", report_o.out_dir, "Output directory")->required();
   report->callback([&] { action = [&] { return cli::run_report(report_o); }; });
 
+  if (const std::string unknown = unknown_command(app, argc, argv); !unknown.empty()) {
+    std::cerr << "actionshift: error: " << unknown << " (see --help)\n";
+    return cli::kBadInput;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

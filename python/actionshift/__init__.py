@@ -34,6 +34,7 @@ from ._native import (  # noqa: F401  (re-exported API)
     methods,
     pool_sha256,
     selftest_library,
+    selftest_sim_options,
     tasks,
     tcp_response,
     tcp_rotation,
@@ -43,7 +44,7 @@ __all__ = [
     "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
     "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
     "make_adapter", "make_vec", "method_needs_calibration", "method_needs_pool", "method_params",
-    "methods", "pool_sha256", "selftest_library", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
+    "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
 ]
 
 PROFILES = ("maniskill", "ideal")

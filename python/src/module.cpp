@@ -22,6 +22,7 @@
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/verdict.hpp"
+#include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 #include "actionshift/sim/task.hpp"
@@ -183,7 +184,11 @@ std::vector<Contract> to_contracts(py::handle h, const char* what) {
     throw py::type_error(std::string(what) + ": expected a pool name, a manifest path or a list of contracts (got " +
                          Py_TYPE(h.ptr())->tp_name + ")");
   std::vector<Contract> out;
-  for (py::handle x : h) out.push_back(to_contract(x));
+  for (py::handle x : h) {
+    // selftest_library() gives (name, contract) pairs: the contract is the second
+    const bool named = py::isinstance<py::tuple>(x) && py::len(x) == 2 && py::isinstance<py::str>(x[py::int_(0)]);
+    out.push_back(to_contract(named ? py::handle(x[py::int_(1)]) : x));
+  }
   if (out.empty()) value_error(std::string(what) + ": must not be empty");
   return out;
 }
@@ -804,7 +809,7 @@ class PySelfTest {
  public:
   PySelfTest(py::object expected, py::object pool, py::object model, const std::string& strategy, int budget,
              double amplitude, double confidence_floor, double misspec_ratio, const std::string& frame_rotation,
-             const std::string& task, py::object gripper)
+             const std::string& task, py::object gripper, py::object misspec_ratio_absolute)
       : task_(task) {
     selftest::Options o;
     // as on the command line: a library contract by name ("swapped-axes"), and "library" for the library pool
@@ -841,6 +846,11 @@ class PySelfTest {
     o.amplitude = amplitude;
     o.confidence_floor = confidence_floor;
     o.misspec_ratio = misspec_ratio;
+    if (!misspec_ratio_absolute.is_none()) {  // the threshold for absolute-target wirings (default: misspec_ratio)
+      if (!py::isinstance<py::float_>(misspec_ratio_absolute) && !py::isinstance<py::int_>(misspec_ratio_absolute))
+        throw py::type_error("misspec_ratio_absolute: expected a number or None");
+      o.misspec_ratio_absolute = misspec_ratio_absolute.cast<double>();
+    }
     if (frame_rotation == "measured") o.frame_rotation = selftest::FrameRotation::kMeasured;
     else if (frame_rotation == "identity") o.frame_rotation = selftest::FrameRotation::kIdentity;
     else throw InputError("selftest options", "frame_rotation", "expected 'measured' or 'identity' (got '" + frame_rotation + "')");
@@ -1129,11 +1139,11 @@ PYBIND11_MODULE(_native, m) {
   // ---- self-test
   py::class_<PySelfTest>(m, "SelfTest", "Plug-and-verify with the control loop inverted (docs/selftest.md).")
       .def(py::init<py::object, py::object, py::object, const std::string&, int, double, double, double,
-                    const std::string&, const std::string&, py::object>(),
+                    const std::string&, const std::string&, py::object, py::object>(),
            py::arg("expected") = py::none(), py::arg("pool") = py::none(), py::arg("model") = py::none(),
            py::arg("strategy") = "entropy", py::arg("budget") = 6, py::arg("amplitude") = 0.5,
            py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "measured",
-           py::arg("task") = "custom", py::arg("gripper") = py::none())
+           py::arg("task") = "custom", py::arg("gripper") = py::none(), py::arg("misspec_ratio_absolute") = py::none())
       .def("begin", &PySelfTest::begin, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
       .def("next_probe", &PySelfTest::next_probe, "The next raw 7-vector to send, or None once the budget is spent.")
       .def("observe", &PySelfTest::observe, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
@@ -1143,6 +1153,38 @@ PYBIND11_MODULE(_native, m) {
       .def("posterior", &PySelfTest::posterior)
       .def("verdict", &PySelfTest::verdict, "The verdict as a dict (the JSON report of `actionshift selftest --json`).")
       .def("report", &PySelfTest::report, "The human report.");
+  m.def(
+      "selftest_sim_options",
+      [](const std::string& task) {
+        (void)sim::parse_task(task);
+        // what `actionshift selftest --sim --task T` sets: the library and reference9 pools (first
+        // occurrence kept), the task's self-test calibration, probes that hold the fingers, and the
+        // misspecification thresholds measured on the simulator (configs/selftest/sim_misspec.json)
+        py::list pool;
+        std::vector<Contract> seen;
+        const auto add = [&](const Contract& c) {
+          if (std::find(seen.begin(), seen.end(), c) != seen.end()) return;
+          seen.push_back(c);
+          pool.append(c);
+        };
+        for (const auto& n : selftest::library()) add(n.contract);
+        for (const auto& c : data::resolve_manifest("reference9").contracts()) add(c);
+        py::dict d;
+        d["pool"] = pool;
+        d["model"] = task;
+        d["task"] = task;
+        d["gripper"] = py::make_tuple(sim::kFingerTargetOffset, sim::kFingerTargetGain);
+        d["budget"] = 6;
+        d["amplitude"] = 0.5;
+        const auto delta = data::builtin_selftest_misspec_ratio(task, "delta");
+        const auto absolute = data::builtin_selftest_misspec_ratio(task, "absolute");
+        d["misspec_ratio"] = delta ? *delta : 4.0;
+        d["misspec_ratio_absolute"] = delta && absolute ? py::cast(*absolute) : py::none();
+        return d;
+      },
+      py::arg("task"),
+      "Keyword arguments of SelfTest that reproduce `actionshift selftest --sim --task TASK` when its probes\n"
+      "drive make(TASK, contract=...): SelfTest(expected=..., **selftest_sim_options(TASK)).");
   m.def("selftest_library", [] {
     std::vector<std::pair<std::string, Contract>> out;
     for (const auto& n : selftest::library()) out.emplace_back(n.name, n.contract);

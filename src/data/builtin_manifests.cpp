@@ -1,11 +1,17 @@
 #include "actionshift/data/builtin_manifests.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/validate.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <utility>
+
+namespace actionshift::embedded {
+extern const std::string_view selftest_sim_misspec;  // configs/selftest/sim_misspec.json
+}
 
 namespace actionshift::data {
 namespace detail {
@@ -26,6 +32,20 @@ std::optional<std::string_view> builtin_calibration_text(std::string_view task, 
 
 std::optional<std::string_view> builtin_selftest_calibration_text(std::string_view task, std::string_view profile) {
   return builtin_calibration_text(std::string("selftest/") + std::string(task), profile);
+}
+
+std::optional<double> builtin_selftest_misspec_ratio(std::string_view task, std::string_view target_class) {
+  const std::string src = "configs/selftest/sim_misspec.json";
+  const nlohmann::json all = parse_json_input(embedded::selftest_sim_misspec, src);
+  const std::string t(task), c(target_class);
+  if (!all.is_object() || !all.contains(t) || !all.at(t).is_object() || !all.at(t).contains(c)) return std::nullopt;
+  const std::string field = t + "." + c + ".misspec_ratio";
+  const nlohmann::json& entry = all.at(t).at(c);
+  if (!entry.is_object() || !entry.contains("misspec_ratio") || !entry.at("misspec_ratio").is_number())
+    throw InputError(src, field, "missing or not a number");
+  const double r = entry.at("misspec_ratio").get<double>();
+  if (!(r > 0.0) || !std::isfinite(r)) throw InputError(src, field, "must be finite and positive");
+  return r;
 }
 
 std::vector<std::string> builtin_calibration_tasks() {

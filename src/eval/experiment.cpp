@@ -188,7 +188,8 @@ struct Context {
 
 namespace {
 EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks,
-                           const std::optional<adapt::ResponseCalibration>& given_calibration);
+                           const std::optional<adapt::ResponseCalibration>& given_calibration,
+                           const std::string& calibration_source = "calibration");
 }  // namespace
 
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) { return make_episode_fn(job, options, EpisodeHooks{}); }
@@ -198,13 +199,14 @@ EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options, E
   policy::RegistryOptions registry;
   registry.external = options.external;
   return build_episode_fn(job, std::shared_ptr<const policy::Policy>(policy::make_policy(job.backbone.name, sim::parse_task(job.task), registry)),
-                          std::move(hooks), options.calibration);
+                          std::move(hooks), options.calibration, options.calibration_source);
 }
 
 namespace {
 
 EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks,
-                           const std::optional<adapt::ResponseCalibration>& given_calibration) {
+                           const std::optional<adapt::ResponseCalibration>& given_calibration,
+                           const std::string& calibration_source) {
   validate_job(job);
   if (!backbone) throw InputError("job", "backbone", "no backbone given");
   auto ctx = std::make_shared<Context>();
@@ -254,9 +256,8 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
                                          : "does not match the built-in calibration of " + job.task + " on profile " + job.profile +
                                                " (" + cal.sha256() + ")");
     if (given_calibration && cal.task != job.task)
-      throw InputError("calibration", "task", "is " + cal.task + ", not the job's " + job.task);  // named by the caller too
-    // a given file is named by the caller, which knows its path (source "calibration")
-    const std::string cal_source = given_calibration ? "calibration" : "built-in calibration " + job.task;
+      throw InputError(calibration_source, "task", "is " + cal.task + ", not the job's " + job.task);
+    const std::string cal_source = given_calibration ? calibration_source : "built-in calibration " + job.task;
     const auto layout_error = [&](const char* field, int is, int want) {
       return InputError(cal_source, field,
                         "is " + std::to_string(is) + ", but " + job.task + "'s observation has it at " + std::to_string(want));

@@ -61,7 +61,7 @@ RenderedEpisode render_episode(const eval::JobSpec& job, std::int64_t episode_in
     out.success.push_back(v.result->success);
   };
   if (o.clean) hooks.contract_override = Contract::identity();
-  const eval::EpisodeFn fn = eval::make_episode_fn(job, std::move(hooks));
+  const eval::EpisodeFn fn = eval::make_episode_fn(job, o.episode, std::move(hooks));
   out.record = fn(task);
   eval::stamp_record(out.record, job, eval::job_id(job), task);
   return out;

@@ -19,6 +19,18 @@ run "$AS" validate "$SRC/manifests"
 expect_rc 0 "validate manifests/"
 expect_out "b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3" "reference9 pool hash"
 expect_out "all checks passed over 11 manifests" "summary line"
+run "$AS" validate "$SRC/manifests/seen.json" --quiet
+expect_out "all checks passed over 1 manifest" "summary line of one manifest"
+
+# a misspelt command is named, with the nearest command (CLI11 said "A subcommand is required")
+run "$AS" summarise results
+expect_rc 2 "misspelt command"
+expect_err "unknown command 'summarise' for actionshift (did you mean 'summarize'?)" "misspelt command"
+run "$AS" gate chek --expected x
+expect_rc 2 "misspelt subcommand"
+expect_err "unknown command 'chek' for actionshift gate (did you mean 'check'?)" "misspelt subcommand"
+run "$AS" validate "$SRC/manifests/seen.json" --quiet
+expect_rc 0 "a command's positional argument is not a command"
 # built-in copies give the same answer with no files
 run "$AS" validate --quiet
 expect_rc 0 "validate built-ins"

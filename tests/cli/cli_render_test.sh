@@ -2,6 +2,7 @@
 # End-to-end: actionshift render / montage / report. Usage: cli_render_test.sh <actionshift> <source dir>
 set -euo pipefail
 AS="$1"
+SRC="$2"
 source "$(dirname "$0")/lib.sh"
 
 JOB=(--task pick_cube --split reference_seen --episodes 2)
@@ -42,6 +43,17 @@ run "$AS" render "${JOB[@]}" --method oracle --frame 0 --camera top --no-overlay
 expect_rc 0 "render png"
 [ "$(head -c 4 "$TMP/ep.png" | tail -c 3)" = "PNG" ] && ok || bad "not a PNG"
 
+# every job option of run reaches render: an external policy with --policy-files renders its run's job
+cp "$SRC/docs/examples/external_policy.py" "$TMP/policy.py"
+EXT=(--task pick_cube --split reference_seen --method oracle --episodes 2 --backbone "external:python3 $TMP/policy.py"
+     --policy-files "$TMP/policy.py")
+run "$AS" run "${EXT[@]}" --threads 1 --progress off --out "$TMP/ext"
+expect_rc 0 "run an external policy"
+run "$AS" render "${EXT[@]}" --size 48x36 --out "$TMP/ext.png"
+expect_rc 0 "render an external policy with --policy-files"
+ext_id=$(basename "$(ls "$TMP"/ext/*.jsonl)" .jsonl)
+grep -qF "\"job_id\":\"$ext_id\"" <<<"$OUT" && ok || bad "render with --policy-files is not the run's job $ext_id"
+
 # montage
 run "$AS" montage "$TMP/ep.gif" "$TMP/ep.gif" --out "$TMP/two.gif"
 expect_rc 0 "montage"; expect_out "2 panels" "montage"
@@ -54,7 +66,7 @@ run "$AS" run "${P[@]}" --method oracle; expect_rc 0 "premise oracle"
 run "$AS" run "${P[@]}" --method no_adapt; expect_rc 0 "premise no_adapt"
 run "$AS" gate1 --results "$TMP/premise"
 run "$AS" report "$TMP/premise" --out "$TMP/report"
-expect_rc 0 "report"; expect_out "figures" "report"
+expect_rc 0 "report"; expect_out "(1 figure, " "report (one figure: Gate 1)"
 [ -s "$TMP/report/index.html" ] && [ -s "$TMP/report/report.md" ] && ok || bad "report pages missing"
 [ -s "$TMP/report/figures/gate1.svg" ] && ok || bad "no Gate 1 figure"
 grep -q 'src="figures/gate1.svg"' "$TMP/report/index.html" && ok || bad "page lacks the Gate 1 figure"

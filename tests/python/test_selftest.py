@@ -50,6 +50,31 @@ def test_selftest_verdict_equals_the_cli(cli, hidden, status):
     assert status in st.report()
 
 
+@pytest.mark.parametrize("task,split,index", [("stack_cube", "reference_unseen_composition", 1),
+                                               ("pick_cube", "reference_seen", 0)])
+def test_selftest_sim_options_reproduce_the_cli(cli, task, split, index):
+    # SelfTest's own defaults are the synthetic stand-in's (misspec_ratio 4.0, no gripper, library
+    # pool): on stack_cube they said MISMATCH where `selftest --sim` says INCONCLUSIVE
+    hidden = actionshift.load_manifest(split).contracts[index]
+    st = actionshift.SelfTest(**actionshift.selftest_sim_options(task))
+    env = actionshift.make(task, contract=hidden)
+    obs, _ = env.reset(seed=20260720)
+    st.begin(*pose(env, obs))
+    while (raw := st.next_probe()) is not None:
+        obs, *_ = env.step(raw)
+        st.observe(*pose(env, obs))
+    v = st.verdict()
+    ref = json.loads(cli("selftest", "--sim", "--task", task, "--hidden-contract", f"{split}:{index}", "--json").stdout)
+    for key in ("status", "identified_contract", "diff_fields", "probe_steps", "fit_ratio", "reason"):
+        assert v[key] == ref[key], (key, v[key], ref[key])
+
+
+def test_selftest_library_pairs_are_a_pool():
+    named = actionshift.selftest_library()
+    st = actionshift.SelfTest(pool=named)
+    assert st.pool == [c for _, c in named]
+
+
 def test_selftest_misuse_raises():
     with pytest.raises(ValueError, match="budget"):
         actionshift.SelfTest(budget=0)

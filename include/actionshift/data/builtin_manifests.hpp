@@ -27,6 +27,10 @@ std::optional<std::string_view> builtin_calibration_text(std::string_view task, 
 /// The self-test's committed calibration (configs/calibration/<profile>/selftest/<task>.json: walks
 /// that never cross an episode reset, the noise a probing self-test sees), or nullopt.
 std::optional<std::string_view> builtin_selftest_calibration_text(std::string_view task, std::string_view profile = "maniskill");
+/// The self-test's misspecification threshold for `task` on the simulator, measured by
+/// `selftest --sim --calibrate-misspec` (configs/selftest/sim_misspec.json) for wirings of
+/// `target_class` "delta" or "absolute"; nullopt if none was measured. InputError if the entry is malformed.
+std::optional<double> builtin_selftest_misspec_ratio(std::string_view task, std::string_view target_class);
 /// Built-in calibrations as "<profile>/<task>" (and "<profile>/selftest/<task>"), sorted.
 std::vector<std::string> builtin_calibration_tasks();
 

@@ -47,6 +47,7 @@ struct EpisodeFnOptions {
   /// --calibration FILE, e.g. one measured under the job's observation noise). Its hash is already
   /// the job's calibration_sha256 (checked: a mismatch is an InputError), so it changes nothing the id does not name.
   std::optional<adapt::ResponseCalibration> calibration;
+  std::string calibration_source{"calibration"};  ///< the file `calibration` was read from, for messages
 };
 
 /// The episode function of `job`. Resolves every name and checks that the split manifest hash, pool

@@ -4,6 +4,7 @@
 /// (eval::make_episode_fn, observed after the reset and after every step), the same episode task
 /// (eval::episode_task: contract slot and seed), and the same record stamping.
 
+#include "actionshift/eval/experiment.hpp"
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/record.hpp"
 #include "actionshift/render/camera.hpp"
@@ -26,6 +27,9 @@ struct EpisodeRenderOptions {
   /// Run the backbone with the identity contract instead of the split's (same episode seed and
   /// initial state): the clean reference panel. The record is then not one the runner writes.
   bool clean{false};
+  /// Run-time options of the episode function, as `run` passes them (an external backbone's step
+  /// timeout, a calibration file): they change no result, so the record is the runner's.
+  eval::EpisodeFnOptions episode;
 };
 
 /// A rendered episode.
