@@ -31,6 +31,11 @@ expect_rc 2 "misspelt subcommand"
 expect_err "unknown command 'chek' for actionshift gate (did you mean 'check'?)" "misspelt subcommand"
 run "$AS" validate "$SRC/manifests/seen.json" --quiet
 expect_rc 0 "a command's positional argument is not a command"
+run "$AS" gate --results "$TMP"
+expect_rc 2 "a command group without its command"
+expect_err "actionshift gate needs a command: check, promote" "a command group without its command"
+run "$AS" gate --help
+expect_rc 0 "a command group's help"
 # built-in copies give the same answer with no files
 run "$AS" validate --quiet
 expect_rc 0 "validate built-ins"
