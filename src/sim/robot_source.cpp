@@ -96,13 +96,13 @@ void check_drivable(const RobotDescription& desc, const std::string& urdf) {
 
 RobotSource load_robot_source(const std::string& urdf, const std::map<std::string, std::string>& packages) {
   std::error_code ec;
-  if (!fs::is_regular_file(urdf, ec)) throw InputError(urdf, "--robot", "no such URDF file");
+  if (!fs::is_regular_file(urdf, ec)) throw InputError(urdf, "robot", "no such URDF file");
   RobotSource r;
   r.urdf = fs::absolute(urdf, ec).lexically_normal().string();
   r.packages = packages;
   PackageMap pm;
   for (const auto& [name, dir] : packages) pm[name] = dir;
-  const std::string bytes = read_bytes(r.urdf, "--robot");
+  const std::string bytes = read_bytes(r.urdf, "robot");
   auto desc = std::make_shared<RobotDescription>(load_urdf_file(r.urdf, pm));
   check_drivable(*desc, urdf);
   r.sha256 = robot_content_sha256(bytes, *desc);
