@@ -1,5 +1,6 @@
 #include "actionshift/eval/runner.hpp"
 
+#include "actionshift/core/error.hpp"
 #include "actionshift/core/workers.hpp"
 #include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/store.hpp"
@@ -254,8 +255,16 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
   if (failure && was_interrupted) {
     message = interrupted_after + "; re-run to resume";
   } else if (failure) {
-    message = "stopped at episode " + std::to_string(failed_at) + " of " + std::to_string(job.episodes) +
-              "; re-run to resume";
+    // the reason is kept with the job, so a summary read later says why it stopped
+    std::string why = "unknown error";
+    try {
+      std::rethrow_exception(failure);
+    } catch (const std::exception& e) {
+      why = printable_input(e.what(), 500);
+    } catch (...) {
+    }
+    message = "stopped at episode " + std::to_string(failed_at) + " of " + std::to_string(job.episodes) + " (" + why +
+              "); re-run to resume";
   } else {
     message = "complete: " + std::to_string(job.episodes) + " episodes" +
               (first > 0 ? " (resumed after " + std::to_string(first) + ")" : "");

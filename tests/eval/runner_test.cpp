@@ -140,7 +140,7 @@ TEST_F(RunnerTest, FailingEpisodeKeepsEarlierRecordsAndResumes) {
   const auto path = root_ / "x" / (job_id(job) + ".jsonl");
   EXPECT_EQ(read_record_file(path.string()).records.size(), 17u);
   const auto summary = nlohmann::json::parse(slurp(root_ / "x" / (job_id(job) + ".summary.json")));
-  EXPECT_THAT(summary["message"].get<std::string>(), HasSubstr("stopped at episode 17"));
+  EXPECT_THAT(summary["message"].get<std::string>(), HasSubstr("stopped at episode 17 of 30 (simulator exploded); re-run to resume"));
   const auto r = run_job(job, testing::fake_episode_fn(), opts("x", 2));
   EXPECT_EQ(r.episodes_before, 17);
   EXPECT_EQ(r.episodes_run, 13);
