@@ -173,7 +173,7 @@ int run_summarize(const SummarizeOptions& o, std::ostream& out, std::ostream& er
     if (!o.out_file.empty()) check_output_file(o.out_file, "--out");
     const eval::ResultSet rs = eval::load_results(o.results_dir);
     for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
-    if (rs.records.empty()) throw InputError(o.results_dir, "", "no episode records (*.jsonl) found");
+    if (rs.records.empty()) throw InputError(o.results_dir, "", eval::no_records_reason(rs));
     const auto cells = eval::summarize_records(rs.records);
     const json j = eval::summary_to_json(cells);
     if (!o.out_file.empty()) {

@@ -188,4 +188,11 @@ std::string summary_to_markdown(const std::vector<CellSummary>& cells) {
   return s.str();
 }
 
+std::string no_records_reason(const ResultSet& results) {
+  if (results.files.empty()) return "holds no episode records (no *.jsonl file)";
+  const std::size_t n = results.files.size();
+  return "holds no episode records: " + std::string(n == 1 ? "its .jsonl file is" : "its " + std::to_string(n) + " .jsonl files are") +
+         " empty (a job that stopped before its first episode says why in its .summary.json)";
+}
+
 }  // namespace actionshift::eval

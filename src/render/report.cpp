@@ -75,7 +75,7 @@ ReportResult write_report(const std::string& results_dir, const std::string& out
   const fs::path in(results_dir);
   if (!fs::is_directory(in)) throw InputError(results_dir, "", "not a directory");
   const eval::ResultSet results = eval::load_results(results_dir);
-  if (results.records.empty()) throw InputError(results_dir, "", "holds no episode records (*.jsonl)");
+  if (results.records.empty()) throw InputError(results_dir, "", eval::no_records_reason(results));
   const std::vector<eval::CellSummary> cells = eval::summarize_records(results.records);
 
   std::vector<JobRow> jobs;

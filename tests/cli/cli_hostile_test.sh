@@ -318,6 +318,12 @@ run timeout 60 "$AS" run --plan "$TMP/failing/failing.plan.json" --out "$TMP/fai
 expect_rc 2 "run --plan with a failing job"
 expect_one_line_error "run --plan with a failing job"
 expect_err "failing.plan.json: jobs[0] (" "run --plan with a failing job names the entry"
+grep -qF 'step 0: process exited with status 1 before replying); re-run to resume' "$TMP"/failing/*.summary.json \
+  && ok || bad "a failed job's summary does not say why it stopped"
+run "$AS" summarize "$TMP/failing"
+expect_rc 2 "summarize a job that stopped before its first episode"
+expect_err "its .jsonl file is empty (a job that stopped before its first episode says why in its .summary.json)" \
+  "summarize a job that stopped before its first episode"
 
 # ---- --profile is checked while parsing: selftest had blamed a missing calibration, bench env printed no option
 run "$AS" bench env --task pick_cube --steps 5 --profile bogus

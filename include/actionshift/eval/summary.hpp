@@ -27,6 +27,10 @@ struct ResultSet {
 /// is invalid (naming `<file>:<line>`).
 ResultSet load_results(const std::string& dir);
 
+/// Why `results` (read from `dir`) holds no records, as one line for an error: no `*.jsonl` at all,
+/// or only empty ones (jobs that stopped before their first episode; their summaries say why).
+std::string no_records_reason(const ResultSet& results);
+
 /// Identity of an episode for pairing across methods: same seed, contract and episode index means
 /// the same initial state.
 struct PairKey {
