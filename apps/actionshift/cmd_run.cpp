@@ -2,6 +2,7 @@
 #include "cmd_run.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/eval/calibrate.hpp"
 #include "actionshift/eval/experiment.hpp"
@@ -68,6 +69,8 @@ adapt::ResponseCalibration load_calibration_file(const std::string& path) {
 
 void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options) {
   check_obs_noise(o.request.obs_noise);
+  // syntax errors and repeated keys of --params are named as the option's (the resolver parses it again)
+  (void)parse_json_input(o.method_params, "command line", "--params");
   eval::JobRequest q = o.request;
   q.method.params = o.method_params;
   job = eval::resolve_job(q, eval::default_resolver());

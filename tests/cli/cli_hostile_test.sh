@@ -259,6 +259,10 @@ run "$AS" contract hash '{"frame":"base","gripper_inverted":false,"lag":0,"permu
 expect_rc 2 "contract with a repeated key"
 expect_one_line_error "contract with a repeated key"
 expect_err "lag: duplicate key in one object" "contract with a repeated key"
+run "$AS" run --task pick_cube --split reference_seen --method entropy_probes --pool reference9 \
+  --params '{"budget":1,"budget":2}' --episodes 1 --out "$TMP/dupparams" --progress off
+expect_rc 2 "--params with a repeated key"
+expect_err "command line: --params.budget: duplicate key in one object" "--params with a repeated key"
 printf 'name: dup\ntasks: [pick_cube]\nsplits: [reference_seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 2\nepisodes: 2000\nbackbone: expert\n' > "$TMP/dup.yaml"
 run "$AS" plan --experiment "$TMP/dup.yaml" --out "$TMP/dupplan"
 expect_rc 2 "experiment with a repeated key"
