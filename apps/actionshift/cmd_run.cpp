@@ -54,17 +54,6 @@ void check_obs_noise(double sigma) {
   }
 }
 
-// --calibration FILE: a response calibration JSON (as `calibrate --out` writes)
-adapt::ResponseCalibration load_calibration_file(const std::string& path) {
-  require_regular_file(path, "a calibration file");
-  std::ifstream in(path, std::ios::binary);
-  std::error_code ec;
-  if (!in || !std::filesystem::is_regular_file(path, ec)) throw InputError(path, "--calibration", "cannot read file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return adapt::ResponseCalibration::from_json(text.str(), path);
-}
-
 }  // namespace
 
 void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options) {
@@ -79,11 +68,8 @@ void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFn
   if (!o.calibration.empty()) {
     if (!job.calibration_sha256)
       throw InputError("command line", "--calibration", "method " + job.method + " uses no response calibration");
-    adapt::ResponseCalibration cal = load_calibration_file(o.calibration);
-    if (cal.task != job.task) throw InputError(o.calibration, "task", "is " + cal.task + ", not the job's " + job.task);
-    const std::string base = cal.profile.substr(0, cal.profile.find('['));
-    if (base != job.profile)
-      throw InputError(o.calibration, "profile", "was measured on " + cal.profile + ", not on the job's profile " + job.profile);
+    adapt::ResponseCalibration cal = adapt::ResponseCalibration::load_for(o.calibration, job.task, "the job's " + job.task,
+                                                                          job.profile, "the job's profile " + job.profile);
     job.calibration_sha256 = cal.sha256();
     options.calibration = std::move(cal);
     options.calibration_source = o.calibration;

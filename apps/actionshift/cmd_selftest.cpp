@@ -59,15 +59,8 @@ std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
 }
 
 adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
-  if (!o.calibration.empty()) {
-    // another task's file reads the pose at another task's observation offsets
-    adapt::ResponseCalibration cal = adapt::ResponseCalibration::load(o.calibration);
-    if (cal.task != o.task) throw InputError(o.calibration, "task", "is " + cal.task + ", not --task " + o.task);
-    const std::string base = cal.profile.substr(0, cal.profile.find('['));
-    if (base != o.profile)
-      throw InputError(o.calibration, "profile", "was measured on " + cal.profile + ", not on --profile " + o.profile);
-    return cal;
-  }
+  if (!o.calibration.empty())
+    return adapt::ResponseCalibration::load_for(o.calibration, o.task, "--task " + o.task, o.profile, "--profile " + o.profile);
   if (auto text = data::builtin_selftest_calibration_text(o.task, o.profile))
     return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/selftest/" + o.task);
   throw InputError("", "--calibration",

@@ -185,4 +185,13 @@ ResponseCalibration ResponseCalibration::load(const std::string& path) {
   return from_json(ss.str(), path);
 }
 
+ResponseCalibration ResponseCalibration::load_for(const std::string& path, const std::string& task, const std::string& task_name,
+                                              const std::string& profile, const std::string& profile_name) {
+  ResponseCalibration cal = load(path);
+  if (cal.task != task) throw InputError(path, "task", "is " + cal.task + ", not " + task_name);
+  const std::string base = cal.profile.substr(0, cal.profile.find('['));
+  if (base != profile) throw InputError(path, "profile", "was measured on " + cal.profile + ", not on " + profile_name);
+  return cal;
+}
+
 }  // namespace actionshift::adapt

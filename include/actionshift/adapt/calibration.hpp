@@ -71,6 +71,12 @@ struct ResponseCalibration {
   /// Parses and validates; throws InputError(source, field, reason).
   static ResponseCalibration from_json(const std::string& text, const std::string& source);
   static ResponseCalibration load(const std::string& path);
+  /// load(path), refused unless it was measured for `task` on `profile` (another task's file would
+  /// read the pose at that task's observation offsets; "maniskill[obs_noise=0.01]" counts as
+  /// maniskill). `task_name` and `profile_name` say where the expected values came from in the
+  /// messages ("the job's pick_cube", "--task pick_cube"). Throws InputError(path, field, reason).
+  static ResponseCalibration load_for(const std::string& path, const std::string& task, const std::string& task_name,
+                                      const std::string& profile, const std::string& profile_name);
 };
 
 }  // namespace actionshift::adapt
