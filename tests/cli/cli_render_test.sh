@@ -7,6 +7,10 @@ source "$(dirname "$0")/lib.sh"
 
 JOB=(--task pick_cube --split reference_seen --episodes 2)
 
+# OSMesa (and llvmpipe's 100 MB libLLVM) is opened by the first render, never at start-up: linking it
+# made every command start 3x slower (docs/results/benchmarks.md, "Command-line start-up")
+if ldd "$AS" | grep -q 'libOSMesa\|libLLVM'; then bad "the CLI links OSMesa or LLVM at start-up"; else ok; fi
+
 # bad output paths and cameras: one line, exit 2, before any episode runs
 run "$AS" render "${JOB[@]}" --method no_adapt --out "$TMP/x.txt"
 expect_rc 2 "render to .txt"; expect_one_line_error "render to .txt"; expect_err "must end in .gif or .png" "render to .txt"

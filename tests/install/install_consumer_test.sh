@@ -14,4 +14,8 @@ out=$("$WORK/build/consumer")
 echo "$out"
 grep -q "identity 6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa" <<<"$out"
 grep -q "reference9 pool b177b082925800655dee9e93c02142f26a703fd2bdf1d97be56a2cb0bf0eeea3" <<<"$out"
+out=$("$WORK/build/render_consumer") || { echo "render consumer failed: $out"; exit 1; }
+echo "$out"
+# the installed program must not load OSMesa (and llvmpipe's libLLVM) before it renders
+if ldd "$WORK/build/render_consumer" | grep -q libOSMesa; then echo "render consumer links libOSMesa"; exit 1; fi
 echo "install consumer: ok"
