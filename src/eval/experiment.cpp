@@ -72,8 +72,9 @@ PlanResolver default_resolver() {
     return PoolRef{m.name(), m.pool_sha256()};
   };
   r.backbone = [](const std::string& task, const std::string& name) {
-    const auto p = policy::make_policy(name, sim::parse_task(task));
-    return BackboneRef{p->name(), p->sha256()};
+    // identity only: an external policy's process is started by the job, not by planning it
+    const policy::BackboneIdentity b = policy::backbone_identity(name, sim::parse_task(task));
+    return BackboneRef{b.name, b.sha256};
   };
   r.calibration = [](const std::string& task, const MethodEntry& m, const std::string& profile) -> std::optional<std::string> {
     if (!adapt::method_needs_calibration(m.name)) return std::nullopt;

@@ -96,10 +96,18 @@ bool is_ready_reply(std::string_view reply) {
 }
 
 ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options)
-    : command_(std::move(command)), task_(task), options_(options), proc_(std::make_unique<Process>()) {
+    : command_(std::move(command)), task_(task), options_(options) {
   if (command_.empty()) throw std::invalid_argument("external policy: empty command");
+  start();
+}
+
+ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<Process> proc)
+    : command_(std::move(command)), task_(task), options_(options), proc_(std::move(proc)) {}
+
+void ExternalPolicy::start() {
   static std::once_flag ignore_sigpipe;
   std::call_once(ignore_sigpipe, [] { std::signal(SIGPIPE, SIG_IGN); });
+  proc_ = std::make_unique<Process>();
   int in_pipe[2], out_pipe[2];
   if (pipe2(in_pipe, O_CLOEXEC) != 0) throw std::runtime_error("external policy: pipe failed");
   if (pipe2(out_pipe, O_CLOEXEC) != 0) {
@@ -152,7 +160,20 @@ ExternalPolicy::~ExternalPolicy() = default;
 std::string ExternalPolicy::sha256() const { return sha256_hex(command_); }
 
 std::unique_ptr<Policy> ExternalPolicy::clone() const {
+  {
+    // a process that has only answered the hello is exactly what a new clone would start: the first
+    // clone of an unused policy takes it over (the runner clones its prototype once per worker, so
+    // this saves one start of the policy process per job; the prototype starts a new one if used)
+    std::lock_guard<std::mutex> lock(handover_mutex_);
+    if (proc_ && episode_ < 0 && step_ == 0)
+      return std::unique_ptr<Policy>(new ExternalPolicy(command_, task_, options_, std::move(proc_)));
+  }
   return std::make_unique<ExternalPolicy>(command_, task_, options_);
+}
+
+void ExternalPolicy::ensure_started() {
+  std::lock_guard<std::mutex> lock(handover_mutex_);
+  if (!proc_) start();
 }
 
 void ExternalPolicy::fail(const std::string& what, const std::string& reason) {
@@ -236,6 +257,7 @@ std::string ExternalPolicy::receive(double timeout_s, const char* what) {
 }
 
 void ExternalPolicy::reset() {
+  ensure_started();
   ++episode_;
   step_ = 0;
   const sim::ObservationLayout& layout = sim::observation_layout(task_);
@@ -248,6 +270,7 @@ void ExternalPolicy::reset() {
 
 Action ExternalPolicy::act(const Eigen::Ref<const Eigen::VectorXd>& obs) {
   check_observation(obs, task_);
+  ensure_started();
   const std::string what = "step " + std::to_string(step_);
   nlohmann::json msg = {{"type", "step"}, {"t", step_}, {"obs", std::vector<double>(obs.data(), obs.data() + obs.size())}};
   send(msg.dump(), what.c_str(), options_.step_timeout_s);

@@ -2,6 +2,7 @@
 #include "actionshift/policy/registry.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
 #include "actionshift/policy/delay_aware.hpp"
 #include "actionshift/policy/expert.hpp"
 #include "actionshift/policy/mlp.hpp"
@@ -25,6 +26,23 @@ std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const 
 }
 
 std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo", "ppo-delay-aware"}; }
+
+namespace {
+std::string external_command(std::string_view backbone) {
+  std::string cmd(backbone.substr(9));
+  if (cmd.empty()) throw InputError("", "backbone", "external: needs a command, e.g. external:python3 policy.py");
+  return cmd;
+}
+}  // namespace
+
+BackboneIdentity backbone_identity(std::string_view backbone, sim::TaskId task, const RegistryOptions& options) {
+  if (backbone.starts_with("external:")) {
+    const std::string cmd = external_command(backbone);
+    return {"external:" + cmd, sha256_hex(cmd)};
+  }
+  const auto p = make_policy(backbone, task, options);
+  return {p->name(), p->sha256()};
+}
 
 std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task, const RegistryOptions& options) {
   if (backbone == "expert") return make_expert(task);
@@ -54,9 +72,7 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
     return p;
   }
   if (backbone.starts_with("external:")) {
-    const std::string cmd(backbone.substr(9));
-    if (cmd.empty()) throw InputError("", "backbone", "external: needs a command, e.g. external:python3 policy.py");
-    return std::make_unique<ExternalPolicy>(cmd, task, options.external);
+    return std::make_unique<ExternalPolicy>(external_command(backbone), task, options.external);
   }
   throw InputError("", "backbone",
                    "unknown backbone '" + std::string(backbone) +

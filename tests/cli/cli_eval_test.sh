@@ -162,4 +162,27 @@ run "$AS" calibrate --task push_cube --protocol sideways
 expect_rc 2 "unknown protocol"
 expect_one_line_error "unknown protocol"
 
+# ---- an external policy starts once per worker: not when the job is planned or resolved, and not
+# once more for a prototype that only gets cloned
+cat > "$TMP/counting.sh" <<EOF
+echo started >> "$TMP/starts.txt"
+read l; echo '{"type":"ready"}'
+while read l; do case "\$l" in *'"step"'*) echo '{"action":[0,0,0,0,0,0,0]}';; esac; done
+EOF
+printf 'name: ext\ntasks: [pick_cube]\nsplits: [reference_seen]\nmethods: [no_adapt]\nseeds: [1, 2]\nepisodes: 2\nbackbone: "external:sh %s"\n' \
+  "$TMP/counting.sh" > "$TMP/ext.yaml"
+rm -f "$TMP/starts.txt"
+run "$AS" plan --experiment "$TMP/ext.yaml" --out "$TMP/extplan"
+expect_rc 0 "plan with an external backbone"
+[ ! -e "$TMP/starts.txt" ] && ok || bad "planning started the external policy $(wc -l < "$TMP/starts.txt") times"
+run "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 2 --threads 1 \
+  --backbone "external:sh $TMP/counting.sh" --out "$TMP/ext1" --progress off
+expect_rc 0 "external job, 1 thread"
+[ "$(wc -l < "$TMP/starts.txt")" -eq 1 ] && ok || bad "1 worker started the policy $(wc -l < "$TMP/starts.txt") times"
+rm -f "$TMP/starts.txt"
+run "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 4 --threads 2 \
+  --backbone "external:sh $TMP/counting.sh" --out "$TMP/ext2" --progress off
+expect_rc 0 "external job, 2 threads"
+[ "$(wc -l < "$TMP/starts.txt")" -eq 2 ] && ok || bad "2 workers started the policy $(wc -l < "$TMP/starts.txt") times"
+
 finish

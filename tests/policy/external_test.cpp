@@ -1,5 +1,5 @@
 // external-process policy: the Python example completes episodes; dead, silent and garbage
-// processes give clear errors instead of hangs or crashes
+// processes give clear errors instead of hangs or crashes; clones start no more processes than needed
 #include "actionshift/core/hash.hpp"
 #include "actionshift/policy/external.hpp"
 #include "actionshift/policy/gate0.hpp"
@@ -7,6 +7,10 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
 
 using namespace actionshift;
 using ::testing::HasSubstr;
@@ -75,6 +79,44 @@ TEST(ExternalPolicy, WellBehavedProcessRoundTrip) {
   auto c = p.clone();
   c->reset();
   EXPECT_DOUBLE_EQ(c->act(pick_obs())(0), 0.5);
+}
+
+
+// counts the processes a policy starts: each start appends a line to `file` before the hello
+std::string counting_policy(const std::string& file) {
+  return "echo started >> '" + file + "'; " + kReady +
+         R"(while read l; do case "$l" in *'"step"'*) echo '{"action":[0.25,0,0,0,0,0,1]}';; esac; done)";
+}
+
+int lines_in(const std::string& file) {
+  std::ifstream in(file);
+  int n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+TEST(ExternalPolicy, FirstCloneOfAnUnusedPolicyTakesOverItsProcess) {
+  const std::string file = ::testing::TempDir() + "external_starts_" + std::to_string(::getpid()) + ".txt";
+  std::remove(file.c_str());
+  policy::ExternalPolicy proto(counting_policy(file), sim::TaskId::kPickCube);
+  EXPECT_EQ(lines_in(file), 1);
+  auto first = proto.clone();  // takes the greeted process
+  EXPECT_EQ(lines_in(file), 1);
+  auto second = proto.clone();  // the prototype has none left: a new process
+  EXPECT_EQ(lines_in(file), 2);
+  first->reset();
+  second->reset();
+  EXPECT_DOUBLE_EQ(first->act(pick_obs())(0), 0.25);
+  EXPECT_DOUBLE_EQ(second->act(pick_obs())(0), 0.25);
+  // a used policy keeps its process: its clones start their own
+  auto third = first->clone();
+  EXPECT_EQ(lines_in(file), 3);
+  EXPECT_DOUBLE_EQ(first->act(pick_obs())(0), 0.25);
+  // the prototype still works after handing its process over: it starts a new one
+  proto.reset();
+  EXPECT_EQ(lines_in(file), 4);
+  EXPECT_DOUBLE_EQ(proto.act(pick_obs())(0), 0.25);
+  std::remove(file.c_str());
 }
 
 }  // namespace

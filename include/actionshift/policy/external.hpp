@@ -14,7 +14,10 @@
 ///   (end: stdin is closed; the process should exit; its process group is killed after 2 s)
 ///
 /// The command runs under `/bin/sh -c`; its stderr is passed through. The process is started
-/// when the policy is constructed (one process per clone, so one per worker thread). A process
+/// when the policy is constructed (one process per clone, so one per worker thread). The first
+/// clone of a policy that has not yet been reset or stepped takes over its greeted process instead
+/// of starting another (the policy starts a new one if it is used after that), so a runner that
+/// builds a prototype and clones it once per worker starts one process per worker, not one more. A process
 /// that exits, closes stdout, exceeds the timeout, or replies with anything but a JSON object with
 /// a 7-number finite "action" array makes act() throw std::runtime_error naming the command, the
 /// step and the reason; nothing hangs: writing a request and waiting for its reply are both bounded
@@ -27,6 +30,7 @@
 
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -67,6 +71,9 @@ class ExternalPolicy final : public Policy {
 
  private:
   struct Process;
+  ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<Process> proc);
+  void start();            // spawn the process and perform the hello (sets proc_)
+  void ensure_started();   // start() again if the process was handed to a clone
   void send(const std::string& line, const char* what, double timeout_s);
   std::string receive(double timeout_s, const char* what);
   bool read_some(const char* what);
@@ -76,7 +83,8 @@ class ExternalPolicy final : public Policy {
   std::string command_;
   sim::TaskId task_;
   ExternalOptions options_;
-  std::unique_ptr<Process> proc_;
+  mutable std::mutex handover_mutex_;     // clone() may run on several threads at once
+  mutable std::unique_ptr<Process> proc_;  // null once handed to a clone (until the next use)
   std::int64_t episode_{-1};
   int step_{0};
 };

@@ -36,6 +36,17 @@ std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const 
 /// if an external process cannot be started.
 std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task, const RegistryOptions& options = {});
 
+/// A backbone's identity: what make_policy(backbone, task)->name() and ->sha256() give.
+struct BackboneIdentity {
+  std::string name;
+  std::string sha256;  ///< 64-hex
+};
+
+/// The identity of a backbone without running it: an external backbone's process is not started
+/// (its SHA-256 is that of its command); any other backbone is built as make_policy builds it, which
+/// checks its weight file. Throws as make_policy does.
+BackboneIdentity backbone_identity(std::string_view backbone, sim::TaskId task, const RegistryOptions& options = {});
+
 /// The built-in backbone names (without the parameterised mlp:<path> and external:<command>).
 std::vector<std::string> builtin_backbones();
 
