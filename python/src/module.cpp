@@ -18,6 +18,7 @@
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
+#include "actionshift/policy/external.hpp"
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
@@ -639,6 +640,40 @@ class PythonPolicy final : public policy::Policy {
   bool copy_{false};
 };
 
+// The policy-call part of the evaluation benchmark (tests/bench/python_bench.py): the same
+// observation handed `calls` times to the Python callable `policy` exactly as evaluate() calls it
+// (from a thread without the GIL, which act() takes), and to the external-process backbone running
+// `command` (a JSON-lines round trip each). Returns the wall times [s] of the two loops
+// {in_process_s, external_s}; the external process is started and greeted before its clock starts.
+py::dict bench_policy_calls(py::object policy, const std::string& command, const std::string& task, std::int64_t calls) {
+  if (!PyCallable_Check(policy.ptr())) throw py::type_error("policy: must be callable (obs -> 7 numbers)");
+  if (calls <= 0) value_error("calls: must be positive");
+  const sim::TaskId id = sim::parse_task(task);
+  sim::HiddenContractEnv env(env_model(id, "maniskill"), Contract::identity());
+  const Eigen::VectorXd obs = env.reset(1);
+  PythonPolicy in_process(policy, "bench", sha256_hex("bench"), id);
+  double in_s = 0.0, ext_s = 0.0, sink = 0.0;
+  {
+    py::gil_scoped_release release;
+    policy::ExternalPolicy external(command, id);
+    in_process.reset();
+    external.reset();
+    auto t0 = std::chrono::steady_clock::now();
+    for (std::int64_t i = 0; i < calls; ++i) sink += in_process.act(obs)(0);
+    auto t1 = std::chrono::steady_clock::now();
+    in_s = std::chrono::duration<double>(t1 - t0).count();
+    t0 = std::chrono::steady_clock::now();
+    for (std::int64_t i = 0; i < calls; ++i) sink += external.act(obs)(0);
+    t1 = std::chrono::steady_clock::now();
+    ext_s = std::chrono::duration<double>(t1 - t0).count();
+  }
+  py::dict d;
+  d["in_process_s"] = in_s;
+  d["external_s"] = ext_s;
+  d["checksum"] = sink;
+  return d;
+}
+
 // backbone identity of a Python policy: "external:<command>" hashes the command exactly as the
 // external-process backbone does (so the job is the one `actionshift run --backbone` writes);
 // any other name is hashed as a whole.
@@ -1094,6 +1129,8 @@ PYBIND11_MODULE(_native, m) {
   });
   m.def("_bench_cpp_steps", &bench_cpp_steps, py::arg("task"), py::arg("actions"), py::arg("seed"),
         py::arg("profile") = "maniskill");
+  m.def("_bench_policy_calls", &bench_policy_calls, py::arg("policy"), py::arg("command"), py::arg("task"),
+        py::arg("calls"));
   m.attr("MAX_NUM_ENVS") = kMaxNumEnvs;
   m.def("env_config_check", [](const std::string& profile) { env_config_for_profile(profile); }, py::arg("profile"));
 
