@@ -112,6 +112,15 @@ def _check_seed(seed, name="seed"):
         raise ValueError(f"{name}: must be an integer in [0, 2**64) (got {seed!r})")
 
 
+def _check_reset_options(options):
+    # Gymnasium passes options through to the environment; these take none, and a silently
+    # ignored option (a contract, a start pose) would make an experiment other than the one asked for
+    if options is not None and (not isinstance(options, dict) or options):
+        got = sorted(map(str, options)) if isinstance(options, dict) else type(options).__name__
+        raise ValueError(f"options: this environment takes no reset options (got {got}); "
+                         "the contract, split and profile are chosen by make()")
+
+
 def _check_types(where, **values):
     # one-line TypeErrors for the constructor arguments (pybind11's own message spans many lines)
     kinds = {"task": (str,), "split": (str, type(None)), "rotation": (str,), "profile": (str,),
@@ -161,6 +170,7 @@ class Env(_EnvBase):
         """Start an episode; the initial state is a pure function of ``seed`` (None: the next
         seed of this env's sequence, so ``reset(seed=s)`` then ``reset()`` is reproducible)."""
         _check_seed(seed)
+        _check_reset_options(options)
         return self._env.reset(None if seed is None else int(seed))
 
     def step(self, action):
@@ -204,6 +214,7 @@ class VecEnv:
     def reset(self, *, seed=None, options=None):
         """Reset every environment; environment i gets seed ``seed + i``."""
         _check_seed(seed)
+        _check_reset_options(options)
         if seed is not None and int(seed) + self.num_envs - 1 >= 2 ** 64:
             raise ValueError(f"seed: seed + num_envs - 1 must be below 2**64 (environment i gets seed + i; got {seed})")
         return self._env.reset(None if seed is None else int(seed))

@@ -172,6 +172,18 @@ def test_largest_seed_and_numpy_integer_seeds_are_accepted():
     actionshift.make_adapter("no_adapt").begin_episode(np.uint64(3))
 
 
+@pytest.mark.parametrize("options", [{"contract": "identity"}, {"x": 1, "a": 2}, "seed=3", [1]])
+def test_reset_options_are_refused_not_ignored(options):
+    env = actionshift.make("pick_cube")
+    vec = actionshift.make_vec("pick_cube", 2)
+    for e in (env, vec):
+        with pytest.raises(ValueError, match=r"options: this environment takes no reset options") as err:
+            e.reset(seed=1, options=options)
+        assert one_line(err)
+    assert np.array_equal(env.reset(seed=1, options={})[0], env.reset(seed=1, options=None)[0])
+    vec.reset(seed=1, options={})
+
+
 @pytest.mark.parametrize("kwargs, error, pattern", [
     ({"task": None}, TypeError, "make: task: expected str"),
     ({"split": 3}, TypeError, "make: split: expected str or None"),
