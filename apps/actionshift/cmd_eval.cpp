@@ -315,6 +315,7 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
         pj.job_id = eval::job_id(pj.spec);
       }
     if (o.slurm) {  // the Slurm options are checked before any file is written
+      if (o.max_array_size && *o.max_array_size == 0) throw InputError("", "--max-array-size", "must be at least 1");
       if (!eval::valid_slurm_time(o.time_limit))
         throw InputError("--time", o.time_limit,
                          "not a Slurm time (M, M:S, H:M:S, D-H, D-H:M, D-H:M:S or UNLIMITED, not zero)");
@@ -349,7 +350,7 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
       so.mem = o.mem;
       so.partition = o.partition;
       so.max_parallel = o.max_parallel;
-      so.max_array_size = o.max_array_size ? o.max_array_size : cluster_max_array_size();
+      so.max_array_size = o.max_array_size ? *o.max_array_size : cluster_max_array_size();
       const std::string script_path =
           o.slurm_file.empty() ? (fs::path(o.out_dir) / (ex.name + ".sbatch")).string() : o.slurm_file;
       so.script_path = fs::absolute(script_path).lexically_normal().string();

@@ -74,7 +74,7 @@ struct PlanOptions {
   std::string mem;                      // --mem (Slurm memory, e.g. 4G; "" → not set)
   std::string partition;                // --partition
   unsigned max_parallel{0};             // --max-parallel N (array throttle)
-  unsigned max_array_size{0};           // --max-array-size N (0 → `scontrol show config`, else 1001)
+  std::optional<unsigned> max_array_size;  // --max-array-size N (unset: `scontrol show config`, else 1001)
   std::optional<eval::RobotRef> robot;  // set by the caller from --robot/--package: every job runs with it
   std::optional<eval::PolicyFilesRef> policy_files;  // set by the caller from --policy-files: every job names them
 };

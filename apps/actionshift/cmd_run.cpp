@@ -137,10 +137,11 @@ int run_calibrate(const CalibrateOptions& o) {
     else throw InputError("", "--drive", "expected implicit_pd or velocity_servo (got '" + o.drive + "')");
     note("drive", o.drive);
   }
-  if (o.solver_iterations != 0) {
-    if (o.solver_iterations < 1 || o.solver_iterations > 1000) throw InputError("", "--solver-iterations", "must be in 1..1000");
-    cfg.physics.solver_iterations = o.solver_iterations;
-    note("solver_iterations", std::to_string(o.solver_iterations));
+  if (o.solver_iterations) {
+    const int it = *o.solver_iterations;
+    if (it < 1 || it > 1000) throw InputError("", "--solver-iterations", "must be in 1..1000 (got " + std::to_string(it) + ")");
+    cfg.physics.solver_iterations = it;
+    note("solver_iterations", std::to_string(it));
   }
   if (!o.joint_limits.empty()) {
     if (o.joint_limits != "on" && o.joint_limits != "off") throw InputError("", "--joint-limits", "expected on or off");

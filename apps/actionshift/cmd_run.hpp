@@ -58,7 +58,7 @@ struct CalibrateOptions {
   // label then names them, e.g. "maniskill[ik=converged]"
   std::string ik;                    // single_step | converged
   std::string drive;                 // implicit_pd | velocity_servo
-  int solver_iterations{0};          // > 0: Bullet solver iterations
+  std::optional<int> solver_iterations;  // set: Bullet solver iterations (1..1000)
   std::string joint_limits;          // on | off: arm joint limit constraints
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table

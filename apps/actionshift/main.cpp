@@ -556,7 +556,8 @@ int main(int argc, char** argv) {
   calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode")->capture_default_str();
   calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
   calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");
-  calibrate->add_option("--solver-iterations", cal_o.solver_iterations, "Ablation: Bullet solver iterations");
+  calibrate->add_option("--solver-iterations", cal_o.solver_iterations,
+                        "Ablation: Bullet solver iterations per step, 1..1000 (default: the profile's, 15)");
   calibrate->add_option("--joint-limits", cal_o.joint_limits, "Ablation: arm joint limit constraints on or off");
   calibrate->add_option("--seed", cal_o.seed, "Seed")->check(kSeed)->capture_default_str();
   calibrate->add_option("--obs-noise", cal_o.obs_noise,

@@ -52,6 +52,9 @@ expect_err "--time: 2h: not a Slurm time" "bad --time message"
 run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad" --slurm --mem 4GB
 expect_rc 2 "bad --mem"
 expect_one_line_error "bad --mem"
+run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad" --slurm --max-array-size 0
+expect_rc 2 "--max-array-size 0"
+expect_err "--max-array-size: must be at least 1" "--max-array-size 0 message"
 run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad" --slurm --executable no-such-actionshift-binary
 expect_rc 2 "missing --executable"
 expect_err "not found on PATH" "missing --executable message"
