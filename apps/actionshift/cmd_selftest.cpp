@@ -228,6 +228,14 @@ int run(const SelftestOptions& o) {
     misspec_source = "uncalibrated default";
   }
 
+  // the report names the task, so it is one of the five with or without --sim
+  const sim::TaskId task_id = [&] {
+    try {
+      return sim::parse_task(o.task);
+    } catch (const InputError& e) {
+      throw InputError("", "--task", e.reason());  // the reason names the valid tasks
+    }
+  }();
   selftest::ReportHeader h;
   h.task = o.task;
   h.strategy = o.strategy;
@@ -235,7 +243,7 @@ int run(const SelftestOptions& o) {
   std::optional<selftest::SelfTest> st;
   std::string err;
   if (o.sim) {
-    const sim::TaskId task = sim::parse_task(o.task);  // InputError naming the valid tasks
+    const sim::TaskId task = task_id;
     if (so.budget > sim::task_horizon(task))
       throw InputError("", "--budget", "must be at most the task horizon " + std::to_string(sim::task_horizon(task)) +
                                            " with --sim (got " + std::to_string(so.budget) + ")");

@@ -281,7 +281,9 @@ int main(int argc, char** argv) {
       "library name, MANIFEST:INDEX (e.g. reference_seen:0), a file with contract JSON, or inline JSON.\n"
       "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
   st->footer("Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input or usage.");
-  st->add_option("--task", st_o.task, "Task (with --sim: pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side)")
+  st->add_option("--task", st_o.task,
+                 "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side: the environment probed with\n"
+                 "--sim, the report's task otherwise")
       ->capture_default_str();
   auto* st_demo = st->add_option("--demo", st_o.demo,
                                  "Synthetic demo wiring: identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled");

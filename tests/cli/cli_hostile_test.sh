@@ -341,5 +341,12 @@ expect_err "--profile: unknown fidelity profile 'bogus' (known: maniskill, ideal
 run "$AS" selftest --sim --task pick_cube --hidden-contract identity --profile bogus
 expect_rc 3 "selftest --profile bogus"
 expect_err "unknown fidelity profile 'bogus'" "selftest --profile bogus"
+# the report names its task: an unknown one is refused with or without --sim
+for sim in "" --sim; do
+  run "$AS" selftest $sim --task pick_cubes --hidden-contract identity
+  expect_rc 3 "selftest $sim --task pick_cubes"
+  expect_one_line_error "selftest $sim --task pick_cubes"
+  expect_err "--task: unknown task 'pick_cubes' (valid: pick_cube," "selftest $sim --task pick_cubes message"
+done
 
 finish
