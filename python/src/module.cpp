@@ -62,6 +62,71 @@ using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 [[noreturn]] void value_error(const std::string& msg) { throw py::value_error(msg); }
 
+// A keyword constructor's parameter for bind_call: its name, what it takes, a check that converts
+// a value as pybind11 would (throws py::cast_error if it cannot) and its default.
+struct CallParam {
+  const char* name;
+  const char* expected;
+  void (*check)(py::handle);
+  py::object default_value;
+};
+
+template <class T>
+void castable(py::handle h) {
+  (void)h.cast<T>();
+}
+
+// The arguments of a keyword constructor's catch-all overload (`*args, **kwargs`), bound to its
+// parameters in order, defaults filled in and every given value checked. pybind11 answers a call
+// that matches no signature with a TypeError of several lines (every signature, then the
+// arguments); registered after the typed overload, this binds the call itself and says in one line
+// what is wrong: too many positional arguments, an unknown or repeated keyword, or the first value
+// that does not convert. (pybind11 tries every overload without implicit conversions before any
+// with them, so a call that needs one, such as integers for floats, also arrives here.)
+std::vector<py::object> bind_call(const char* callee, const std::vector<CallParam>& params, const py::args& args,
+                                  const py::kwargs& kwargs) {
+  const std::string who = std::string(callee) + "(): ";
+  std::string names;
+  for (const CallParam& p : params) names += (names.empty() ? "" : ", ") + std::string(p.name);
+  if (args.size() > params.size())
+    throw py::type_error(who + "takes at most " + std::to_string(params.size()) + " arguments (" + names + "), got " +
+                         std::to_string(args.size()) + " positional");
+  std::vector<py::object> values(params.size());
+  for (std::size_t i = 0; i < args.size(); ++i) values[i] = py::reinterpret_borrow<py::object>(args[i]);
+  for (auto item : kwargs) {
+    const std::string key = py::str(item.first);
+    const auto it = std::find_if(params.begin(), params.end(), [&](const CallParam& p) { return key == p.name; });
+    if (it == params.end())
+      throw py::type_error(who + "unknown keyword argument '" + key.substr(0, 80) + "' (known: " + names + ")");
+    const auto k = static_cast<std::size_t>(it - params.begin());
+    if (k < args.size()) throw py::type_error(who + "'" + key + "' given twice (by position and by keyword)");
+    values[k] = py::reinterpret_borrow<py::object>(item.second);
+  }
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    if (!values[k]) {
+      values[k] = params[k].default_value;
+      continue;
+    }
+    try {
+      params[k].check(values[k]);
+    } catch (const py::cast_error&) {
+      throw py::type_error(who + params[k].name + ": expected " + params[k].expected + " (got " +
+                           Py_TYPE(values[k].ptr())->tp_name + ")");
+    }
+  }
+  return values;
+}
+
+Contract make_contract(std::vector<long long> permutation, std::vector<long long> sign, std::vector<double> scale,
+                       std::string target, std::string frame, long long lag, bool gripper_inverted) {
+  ContractFields f{std::move(permutation), std::move(sign), std::move(scale), std::move(target), std::move(frame), lag,
+                   gripper_inverted};
+  std::string err;
+  auto c = Contract::try_make(f, &err);
+  if (!c) throw InputError("contract", "", err);
+  return *c;
+}
+
 std::string shape_of(const DArray& a) {
   std::ostringstream s;
   s << "(";
@@ -961,19 +1026,26 @@ PYBIND11_MODULE(_native, m) {
 
   // ---- contracts and the core
   py::class_<Contract>(m, "Contract", "An immutable action contract (see docs/splits.md).")
-      .def(py::init([](std::vector<long long> permutation, std::vector<long long> sign, std::vector<double> scale,
-                       std::string target, std::string frame, long long lag, bool gripper_inverted) {
-             ContractFields f{std::move(permutation), std::move(sign), std::move(scale), std::move(target),
-                              std::move(frame), lag, gripper_inverted};
-             std::string err;
-             auto c = Contract::try_make(f, &err);
-             if (!c) throw InputError("contract", "", err);
-             return *c;
-           }),
+      .def(py::init(&make_contract),
            py::arg("permutation") = std::vector<long long>{0, 1, 2, 3, 4, 5},
            py::arg("sign") = std::vector<long long>{1, 1, 1, 1, 1, 1},
            py::arg("scale") = std::vector<double>{1, 1, 1, 1, 1, 1}, py::arg("target") = "delta",
            py::arg("frame") = "base", py::arg("lag") = 0, py::arg("gripper_inverted") = false)
+      .def(py::init([](const py::args& args, const py::kwargs& kwargs) {
+        const auto v = bind_call(
+            "Contract",
+            {{"permutation", "a sequence of 6 integers", &castable<std::vector<long long>>, py::cast(std::vector<long long>{0, 1, 2, 3, 4, 5})},
+             {"sign", "a sequence of 6 integers (+1 or -1)", &castable<std::vector<long long>>, py::cast(std::vector<long long>{1, 1, 1, 1, 1, 1})},
+             {"scale", "a sequence of 6 numbers", &castable<std::vector<double>>, py::cast(std::vector<double>{1, 1, 1, 1, 1, 1})},
+             {"target", "a str", &castable<std::string>, py::str("delta")},
+             {"frame", "a str", &castable<std::string>, py::str("base")},
+             {"lag", "an int", &castable<long long>, py::int_(0)},
+             {"gripper_inverted", "a bool", &castable<bool>, py::bool_(false)}},
+            args, kwargs);
+        return make_contract(v[0].cast<std::vector<long long>>(), v[1].cast<std::vector<long long>>(),
+                             v[2].cast<std::vector<double>>(), v[3].cast<std::string>(), v[4].cast<std::string>(),
+                             v[5].cast<long long>(), v[6].cast<bool>());
+      }))
       .def_static("identity", &Contract::identity)
       .def_static("from_json", [](py::handle h) { return to_contract(h); }, py::arg("json"),
                   "From JSON text or a dict; raises ValueError (actionshift.InputError) with the reason.")
@@ -1181,6 +1253,25 @@ PYBIND11_MODULE(_native, m) {
            py::arg("strategy") = "entropy", py::arg("budget") = 6, py::arg("amplitude") = 0.5,
            py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "measured",
            py::arg("task") = "custom", py::arg("gripper") = py::none(), py::arg("misspec_ratio_absolute") = py::none())
+      .def(py::init([](const py::args& args, const py::kwargs& kwargs) {
+        const auto v = bind_call("SelfTest",
+                                 {{"expected", "a contract", &castable<py::object>, py::none()},
+                                  {"pool", "a pool", &castable<py::object>, py::none()},
+                                  {"model", "a response model", &castable<py::object>, py::none()},
+                                  {"strategy", "a str", &castable<std::string>, py::str("entropy")},
+                                  {"budget", "an int", &castable<int>, py::int_(6)},
+                                  {"amplitude", "a number", &castable<double>, py::float_(0.5)},
+                                  {"confidence_floor", "a number", &castable<double>, py::float_(0.9)},
+                                  {"misspec_ratio", "a number", &castable<double>, py::float_(4.0)},
+                                  {"frame_rotation", "a str", &castable<std::string>, py::str("measured")},
+                                  {"task", "a str", &castable<std::string>, py::str("custom")},
+                                  {"gripper", "a gripper description", &castable<py::object>, py::none()},
+                                  {"misspec_ratio_absolute", "a number or None", &castable<py::object>, py::none()}},
+                                 args, kwargs);
+        return std::make_unique<PySelfTest>(v[0], v[1], v[2], v[3].cast<std::string>(), v[4].cast<int>(),
+                                            v[5].cast<double>(), v[6].cast<double>(), v[7].cast<double>(),
+                                            v[8].cast<std::string>(), v[9].cast<std::string>(), v[10], v[11]);
+      }))
       .def("begin", &PySelfTest::begin, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())
       .def("next_probe", &PySelfTest::next_probe, "The next raw 7-vector to send, or None once the budget is spent.")
       .def("observe", &PySelfTest::observe, py::arg("position"), py::arg("quaternion"), py::arg("fingers") = py::none())

@@ -149,3 +149,29 @@ def test_decoder_sizes_and_contract_dict_errors_are_one_line():
     with pytest.raises(ValueError) as e:
         actionshift.Contract.from_json("{")
     assert not str(e.value).startswith("contract: contract:")
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: actionshift.Contract(1, 2, 3), "Contract(): permutation: expected a sequence of 6 integers (got int)"),
+    (lambda: actionshift.Contract(lag="2"), "Contract(): lag: expected an int (got str)"),
+    (lambda: actionshift.Contract(perm=[0, 1, 2, 3, 4, 5]), "Contract(): unknown keyword argument 'perm' (known: permutation,"),
+    (lambda: actionshift.Contract([0, 1, 2, 3, 4, 5], permutation=[0, 1, 2, 3, 4, 5]),
+     "Contract(): 'permutation' given twice (by position and by keyword)"),
+    (lambda: actionshift.Contract(*range(8)), "Contract(): takes at most 7 arguments"),
+    (lambda: actionshift.SelfTest(budget="6"), "SelfTest(): budget: expected an int (got str)"),
+    (lambda: actionshift.SelfTest(amplitude=None), "SelfTest(): amplitude: expected a number (got NoneType)"),
+    (lambda: actionshift.SelfTest(budjet=6), "SelfTest(): unknown keyword argument 'budjet'"),
+])
+def test_constructor_calls_that_match_no_signature_are_one_line_type_errors(call, message):
+    # pybind11's own message lists every signature over several lines
+    with pytest.raises(TypeError) as e:
+        call()
+    assert str(e.value).startswith(message), str(e.value)
+    assert "\n" not in str(e.value)
+    # valid calls build the same objects whichever overload binds them: a call that needs a
+    # conversion (integers for floats) is bound by the catch-all overload, with the same defaults
+    assert actionshift.Contract(lag=2).lag == 2
+    assert actionshift.Contract(scale=[1, 1, 1, 1, 1, 1]).hash() == actionshift.Contract().hash() \
+        == actionshift.Contract.identity().hash()
+    assert actionshift.Contract(scale=[0.5, 1, 2, 1, 1, 1]).scale == [0.5, 1.0, 2.0, 1.0, 1.0, 1.0]
+    assert actionshift.SelfTest(amplitude=1).verdict() == actionshift.SelfTest(amplitude=1.0).verdict()
