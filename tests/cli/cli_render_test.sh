@@ -10,6 +10,16 @@ JOB=(--task pick_cube --split reference_seen --episodes 2)
 # OSMesa (and llvmpipe's 100 MB libLLVM) is opened by the first render, never at start-up: linking it
 # made every command start 3x slower (docs/results/benchmarks.md, "Command-line start-up")
 if ldd "$AS" | grep -q 'libOSMesa\|libLLVM'; then bad "the CLI links OSMesa or LLVM at start-up"; else ok; fi
+# without the library (hidden by a bind mount in a private mount namespace, where the machine allows
+# one), a render is a one-line error naming the package, and writes nothing
+MESA=$(ldconfig -p 2>/dev/null | awk '/libOSMesa\.so\.8 .*x86-64/ {print $NF; exit}')
+if [ -n "$MESA" ] && unshare -m true 2>/dev/null; then
+  run unshare -m sh -c "mount --bind /dev/null '$(readlink -f "$MESA")' && exec '$AS' render ${JOB[*]} --method no_adapt --out '$TMP/nomesa.png'"
+  expect_rc 2 "render without OSMesa"; expect_one_line_error "render without OSMesa"
+  expect_err "rendering needs OSMesa, which could not be loaded" "render without OSMesa"
+  expect_err "apt-get install libosmesa6" "render without OSMesa names the package"
+  [ ! -e "$TMP/nomesa.png" ] && ok || bad "a render without OSMesa left a file"
+fi
 
 # bad output paths and cameras: one line, exit 2, before any episode runs
 run "$AS" render "${JOB[@]}" --method no_adapt --out "$TMP/x.txt"
