@@ -129,6 +129,8 @@ def main():
         ap.error("--episodes must be at least 2 (the 1-episode job is the reference), --steps, --runs and --calls positive")
     cpp, py, cpp_runs, py_runs = bench_steps(a.task, a.steps, a.runs)
     threads = [int(t) for t in a.threads.split(",")]
+    if 1 not in threads:
+        threads.insert(0, 1)  # the 1-thread jobs are the reference of the cost split
     inproc, external, job_steps = bench_evaluate(a.cli, a.episodes, a.runs, threads)
     inproc1, external1, steps1 = bench_evaluate(a.cli, 1, a.runs, [1])
     call_in, call_ext, call_in_runs, call_ext_runs = bench_policy_calls(a.task, a.calls, a.runs)
@@ -141,15 +143,15 @@ def main():
         "evaluate": [{"threads": t, "in_process_s": med(inproc[t]), "external_s": med(external[t]),
                       "speedup": med(external[t]) / med(inproc[t]),
                       "in_process_runs_s": inproc[t], "external_runs_s": external[t]} for t in threads],
-        "costs_1_thread": {
-            side: dict(zip(("fixed_s", "per_step_us"), (lambda f, p: (f, p * 1e6))(*split_costs(
-                med(short[1]), steps1, med(long[1]), job_steps)))) | {"one_episode_runs_s": short[1]}
-            for side, short, long in (("in_process", inproc1, inproc), ("external", external1, external))},
+        "costs_1_thread": {},
         "policy_call": {"calls": a.calls, "in_process_us": call_in * 1e6, "external_us": call_ext * 1e6,
                         "ratio": call_ext / call_in,
                         "in_process_runs_us": [x * 1e6 for x in call_in_runs],
                         "external_runs_us": [x * 1e6 for x in call_ext_runs]},
     }
+    for side, short, long in (("in_process", inproc1, inproc), ("external", external1, external)):
+        fixed, per_step = split_costs(med(short[1]), steps1, med(long[1]), job_steps)
+        result["costs_1_thread"][side] = {"fixed_s": fixed, "per_step_us": per_step * 1e6, "one_episode_runs_s": short[1]}
     if a.json:
         print(json.dumps(result, indent=2))
         return
