@@ -665,6 +665,34 @@ double bench_cpp_steps(const std::string& task, const DArray& actions, std::uint
 // copy.deepcopy(obj); the GIL must be held
 py::object deepcopy(const py::object& obj) { return py::module_::import("copy").attr("deepcopy")(obj); }
 
+// pybind11's gil_scoped_acquire on a thread without a Python thread state creates one and deletes
+// it again on release. Called from a runner worker, every policy call allocated a thread state and
+// its frame stack (mmap) and freed them (munmap, whose TLB shootdown interrupts the other cores):
+// a 2-thread evaluate() used 50 % more CPU than a 1-thread one. The first call on such a thread
+// registers one thread state for the rest of the thread's life (PyGILState_Ensure keeps it while
+// its count is above zero), which gil_scoped_acquire then finds and reuses; it is deleted when the
+// thread exits (run_job joins its workers while the caller has released the GIL).
+class KeptThreadState {
+ public:
+  KeptThreadState() : state_(PyGILState_Ensure()), saved_(PyEval_SaveThread()) {}
+  ~KeptThreadState() {
+    PyEval_RestoreThread(saved_);
+    PyGILState_Release(state_);
+  }
+  KeptThreadState(const KeptThreadState&) = delete;
+  KeptThreadState& operator=(const KeptThreadState&) = delete;
+
+ private:
+  PyGILState_STATE state_;
+  PyThreadState* saved_;
+};
+
+// call before gil_scoped_acquire on a thread that may not be Python's (without the GIL)
+void keep_python_thread_state() {
+  if (PyGILState_GetThisThreadState() != nullptr) return;  // a Python thread, or kept already
+  thread_local KeptThreadState kept;
+}
+
 // A Python callable obs -> 7 numbers as a policy::Policy. reset() calls the object's `reset()`
 // method if it has one. Clones share the one Python object (one worker), or each is a deep copy.
 class PythonPolicy final : public policy::Policy {
@@ -679,11 +707,13 @@ class PythonPolicy final : public policy::Policy {
     fn_.reset();
   }
   void reset() override {
+    keep_python_thread_state();
     py::gil_scoped_acquire gil;
     if (py::hasattr(*fn_, "reset")) fn_->attr("reset")();
   }
   Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override {
     policy::check_observation(obs, task_);
+    keep_python_thread_state();
     py::gil_scoped_acquire gil;
     py::object out = (*fn_)(vec_out(obs.data(), obs.size()));
     Action a = to_vec<kActionDim>(out, "policy output");
@@ -693,6 +723,7 @@ class PythonPolicy final : public policy::Policy {
   std::string sha256() const override { return sha_; }
   sim::TaskId task() const override { return task_; }
   std::unique_ptr<policy::Policy> clone() const override {
+    keep_python_thread_state();
     py::gil_scoped_acquire gil;
     if (!copy_) return std::make_unique<PythonPolicy>(*fn_, name_, sha_, task_);
     return std::make_unique<PythonPolicy>(deepcopy(*fn_), name_, sha_, task_);
