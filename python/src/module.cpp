@@ -20,6 +20,7 @@
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/policy/external.hpp"
 #include "actionshift/policy/policy.hpp"
+#include "actionshift/policy/registry.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/verdict.hpp"
@@ -773,13 +774,15 @@ py::dict bench_policy_calls(py::object policy, const std::string& command, const
 // backbone identity of a Python policy: "external:<command>" hashes the command exactly as the
 // external-process backbone does (so the job is the one `actionshift run --backbone` writes);
 // any other name is hashed as a whole.
-eval::BackboneRef backbone_ref(const std::string& name) {
+eval::BackboneRef backbone_ref(const std::string& name, sim::TaskId task) {
   if (name.empty()) throw InputError("evaluate", "backbone", "must not be empty");
-  static constexpr std::string_view kExternal = "external:";
-  if (name.rfind(kExternal, 0) == 0) {
-    const std::string command = name.substr(kExternal.size());
-    if (command.empty()) throw InputError("evaluate", "backbone", "external: needs a command");
-    return {name, sha256_hex(command)};
+  if (name.starts_with("external:")) {
+    try {
+      const policy::BackboneIdentity b = policy::backbone_identity(name, task);  // the CLI's identity
+      return {b.name, b.sha256};
+    } catch (const InputError& e) {
+      throw InputError("evaluate", e.field(), e.reason());
+    }
   }
   return {name, sha256_hex(name)};
 }
@@ -804,7 +807,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.episodes = episodes;
   q.source = "evaluate";
   eval::PlanResolver resolver = eval::default_resolver();
-  resolver.backbone = [](const std::string&, const std::string& name) { return backbone_ref(name); };
+  resolver.backbone = [](const std::string& t, const std::string& name) { return backbone_ref(name, sim::parse_task(t)); };
   const eval::JobSpec job = eval::resolve_job(q, resolver);
   // threads > 1: the physics of the episodes runs in parallel without the GIL; each worker calls its
   // own copy.deepcopy of the policy (a stateful policy must not see two episodes at once). Checked
