@@ -314,7 +314,9 @@ TEST(PaperNumbers, EveryCommittedEntryParsesAndCarriesASource) {
     EXPECT_FALSE(e.source.empty());
     EXPECT_TRUE(e.entry.contains("seeds"));
     EXPECT_TRUE(e.entry.contains("episodes"));
-    if (e.kind == "difference") EXPECT_TRUE(e.entry.contains("significant"));
+    if (e.kind == "difference") {
+      EXPECT_TRUE(e.entry.contains("significant"));
+    }
   }
   // spot checks against the paper: Table 5 Pick/seen entropy, §5.2's gate clear, Table 2's Push/seen floor
   const PaperNumber* entropy = find_paper_cell(p, "success_once", "pick_cube", "reference_seen", "entropy_probes", "expert");
