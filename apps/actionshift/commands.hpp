@@ -63,4 +63,16 @@ struct BenchEnvOptions {
 };
 int run_bench_env(const BenchEnvOptions& o);
 
+// ---- compare (cmd_compare.cpp, eval layer)
+// `actionshift compare RESULTS_DIR... [--pair 'CANDIDATE vs BASELINE']... [--pairs-from FILE] [--paper FILE]
+//  [--out FILE]`: the comparison JSON (docs/formats.md "Comparison") on stdout or in FILE.
+struct CompareOptions {
+  std::vector<std::string> results_dirs;  ///< RESULTS_DIR... (positional, at least one)
+  std::vector<std::string> pairs;         ///< --pair 'CANDIDATE vs BASELINE' (repeatable)
+  std::string pairs_file;                 ///< --pairs-from FILE: one 'CANDIDATE vs BASELINE' per line
+  std::string paper_file;                 ///< --paper FILE ("" → the built-in configs/paper/numbers.json)
+  std::string out_file;                   ///< --out FILE ("" → stdout)
+};
+int run_compare(const CompareOptions& o);
+
 }  // namespace actionshift::cli

@@ -542,6 +542,27 @@ int main(int argc, char** argv) {
   gate_promote->add_option("--verdict", gp_o.verdict_file, "Verdict file (default <results>/promotion.<c>.vs.<b>.json)");
   gate_promote->callback([&] { action = [&] { return cli::run_gate_promote(gp_o); }; });
 
+  cli::CompareOptions cmp_o;
+  auto* compare = app.add_subcommand(
+      "compare",
+      "Everything a results page needs, as one JSON document (docs/formats.md, Comparison): per cell (task, split,\n"
+      "method label, backbone) success with its Wilson 95 % interval, per-seed rates, probe steps and displacement,\n"
+      "safety-flag rates and the paper's number; per --pair and (task, split, backbone) holding both labels the\n"
+      "paired bootstrap difference (10000 resamples, seed 20260718), per-seed differences, the paper's difference\n"
+      "with its significance, whether the signs agree, and the promotion verdict with the rule that decided.\n"
+      "Cells whose episodes do not pair exactly are an error. Method labels are opaque and may hold '{', ',' and\n"
+      "'=' (e.g. entropy_probes{calibrated}); only a label without a {...} suffix gets the paper's numbers.");
+  compare->add_option("results", cmp_o.results_dirs, "Results directories (their records are merged)")->required();
+  compare->add_option("--pair", cmp_o.pairs,
+                      "A comparison 'CANDIDATE vs BASELINE' (one argument, quoted; the separator is ' vs ' with its\n"
+                      "spaces, so labels may hold any other character); repeatable");
+  compare->add_option("--pairs-from", cmp_o.pairs_file,
+                      "A file of pairs: one 'CANDIDATE vs BASELINE' per line; blank lines and # comments ignored");
+  compare->add_option("--paper", cmp_o.paper_file,
+                      "Paper-numbers file (default: configs/paper/numbers.json as compiled into this build)");
+  compare->add_option("--out", cmp_o.out_file, "Write the JSON here (default: stdout)");
+  compare->callback([&] { action = [&] { return cli::run_compare(cmp_o); }; });
+
   cli::CalibrateOptions cal_o;
   auto* calibrate = app.add_subcommand(
       "calibrate", "Measure each pose channel's response gain, noise and R^2 on the unwrapped environment with\n"

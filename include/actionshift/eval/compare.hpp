@@ -1,0 +1,113 @@
+#pragma once
+/// \file One statistics engine for results pages (`actionshift compare`; docs/formats.md "Comparison"
+/// and "Paper numbers"): per cell the success rate with its Wilson interval, per-seed rates, probe
+/// cost and safety flags; per pair of method labels and (task, split, backbone) the paired bootstrap
+/// difference, its per-seed differences and the promotion verdict (gates.hpp); the paper's numbers
+/// (configs/paper/numbers.json) beside ours.
+
+#include "actionshift/eval/record.hpp"
+#include "actionshift/eval/statistics.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace actionshift::eval {
+
+/// Version of the comparison JSON written by compare_records.
+inline constexpr std::string_view kComparisonSchemaVersion = "1.0";
+/// Version of the paper-numbers file this build reads.
+inline constexpr std::string_view kPaperNumbersSchemaVersion = "1.0";
+
+/// A comparison of two method labels (opaque strings, e.g. `entropy_probes` or
+/// `entropy_probes{calibrated}`): candidate − baseline.
+struct ComparisonPair {
+  std::string candidate;
+  std::string baseline;
+  bool operator==(const ComparisonPair&) const = default;
+};
+
+/// Parse `CANDIDATE vs BASELINE` (exactly one " vs ", both sides non-empty and different; labels may
+/// hold `{`, `,`, `=`). Throws InputError(source, field, reason).
+ComparisonPair parse_comparison_pair(std::string_view text, const std::string& source, const std::string& field);
+
+/// The pairs of a pairs file: one `CANDIDATE vs BASELINE` per line; blank lines and lines starting
+/// with `#` are ignored. Errors name `<source>:<line>`.
+std::vector<ComparisonPair> parse_pairs_text(std::string_view text, const std::string& source);
+
+/// The method's base name: the label before its first `{` (the whole label if it has none).
+std::string method_base_name(std::string_view label);
+
+/// One entry of the paper-numbers file (docs/formats.md "Paper numbers").
+struct PaperNumber {
+  std::string id;                 ///< unique, e.g. "table5.pick_cube.reference_seen.entropy_probes.success"
+  std::string kind;               ///< "cell", "difference" or "scalar"
+  std::string quantity;           ///< e.g. "success_once", "mean_probe_steps", "success_difference"
+  std::string task, split;        ///< cell and difference entries
+  std::string method;             ///< cell entries: the paper's method (a base name, no `{`)
+  std::string candidate, baseline;  ///< difference entries
+  std::string variant;            ///< non-empty: a configuration other than the method's default; never matched to cells
+  std::vector<std::string> backbones;  ///< our backbones the number is set beside; empty: any backbone
+  double value{0.0};
+  std::optional<std::pair<double, double>> interval;  ///< the paper's 95 % interval, if it gives one
+  std::optional<bool> significant;  ///< difference entries: the paper's interval excludes 0; nullopt: not known
+  std::string source;             ///< where in the paper ("Table 5", "§5.8", "Fig. 4") or "reference implementation ..."
+  nlohmann::json entry;           ///< the entry as written in the file (what the comparison prints)
+};
+
+/// A parsed paper-numbers file.
+struct PaperNumbers {
+  std::string source;              ///< file path, or "built-in configs/paper/numbers.json"
+  std::vector<PaperNumber> entries;
+};
+
+/// Parse and validate a paper-numbers file. Throws InputError(source, "entries[i].<field>", reason)
+/// for a missing or mistyped field, a duplicate id, two entries that would match the same cell or pair
+/// with the same backbone scope, or a difference whose `significant` contradicts its interval.
+PaperNumbers parse_paper_numbers(std::string_view text, const std::string& source);
+
+/// The paper-numbers file compiled into this build (configs/paper/numbers.json).
+PaperNumbers builtin_paper_numbers();
+
+/// The paper's number for a cell quantity: the entry whose backbones list `backbone` wins over one
+/// that names no backbone; nullptr if none (or `method` carries a `{...}` suffix).
+const PaperNumber* find_paper_cell(const PaperNumbers& paper, std::string_view quantity, std::string_view task,
+                                   std::string_view split, std::string_view method, std::string_view backbone);
+
+/// The paper's difference for a pair (as find_paper_cell). `*reversed` is set when the entry is
+/// baseline − candidate (its value and interval are then to be negated).
+const PaperNumber* find_paper_difference(const PaperNumbers& paper, std::string_view task, std::string_view split,
+                                         std::string_view candidate, std::string_view baseline, std::string_view backbone,
+                                         bool* reversed);
+
+/// What was read, for the `inputs` block of the comparison.
+struct CompareInputs {
+  struct Directory {
+    std::string dir;
+    std::vector<std::string> files;
+    std::size_t records{0};
+    std::vector<std::string> notes;
+  };
+  std::vector<Directory> directories;
+};
+
+/// The comparison of `records` (docs/formats.md "Comparison"). Cells are those of summarize_records;
+/// each pair is compared in every (task, split, backbone) holding both labels, with
+/// paired_success_difference over the pairs sorted by PairKey (kBootstrapSamples resamples, seed
+/// kBootstrapSeed) and promotion_verdict. Throws InputError naming the cell if a pair's two cells do
+/// not hold the same episodes (seed, contract, episode index) or ran different contracts, and naming
+/// the pair if no (task, split, backbone) holds both labels.
+nlohmann::json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
+                               const PaperNumbers& paper, const CompareInputs& inputs = {});
+
+/// load_results of every directory, then compare_records. Throws InputError for a directory without
+/// records (naming it) and as compare_records.
+nlohmann::json compare_directories(const std::vector<std::string>& dirs, const std::vector<ComparisonPair>& pairs,
+                                   const PaperNumbers& paper);
+
+}  // namespace actionshift::eval
