@@ -6,8 +6,8 @@ Runs an `.asmlp` backbone, evaluated in numpy exactly as the C++ MlpPolicy evalu
 (float32, tanh hidden layers, linear output clipped to [-1, 1]; a delay-aware file gets its own
 last 4 emitted outputs, most recent first, zeros at episode start), through an adapter on the
 contracts of a split, with a Python copy of the runner's episode loop (src/eval/experiment.cpp,
-Context::run): episode i runs contract i mod n with env seed episode_seed(seed, i mod n, i) and
-adapter seed adapter_episode_seed(seed, i div n); per step: act, R from the observation, encode,
+Context::run): episode i runs contract deal_permutation(seed, n, i div n)[i mod n] with env seed
+episode_seed(seed, i div n) and adapter seed adapter_episode_seed(seed, i div n); per step: act, R from the observation, encode,
 step, stop on a safety flag, response, observe, stop at the horizon. `--verify` runs the same
 numpy policy through actionshift.evaluate() and compares the per-episode success flags.
 
@@ -62,10 +62,18 @@ def splitmix64(x):
     return z ^ (z >> 31)
 
 
-def episode_seed(seed, contract_index, episode_index):
-    h = splitmix64(seed & M64)
-    h = splitmix64(h ^ (contract_index & M64))
-    return splitmix64(h ^ (episode_index & M64))
+def episode_seed(seed, block):
+    return splitmix64(splitmix64(splitmix64(seed & M64) ^ 0x696e6974737461) ^ (block & M64))
+
+
+def deal_permutation(seed, n, block):
+    s = splitmix64(splitmix64((seed ^ 0x6465616c696e67) & M64) ^ (block & M64))
+    perm = list(range(n))
+    for j in range(n - 1, 0, -1):
+        s = splitmix64(s)
+        k = s % (j + 1)
+        perm[j], perm[k] = perm[k], perm[j]
+    return perm
 
 
 def adapter_episode_seed(seed, contract_episode):
@@ -180,7 +188,8 @@ def run_cell(task, backbone, method, split, pool, seed, episodes, history="own",
     envs = {}
     eps = []
     for i in range(episodes):
-        ci, ce = i % n, i // n
+        ce = i // n
+        ci = deal_permutation(seed, n, ce)[i % n]
         truth = contracts[ci]
         if ci not in envs:
             envs[ci] = actionshift.make(task, contract=truth, profile=profile)
@@ -189,7 +198,7 @@ def run_cell(task, backbone, method, split, pool, seed, episodes, history="own",
                                            truth=truth if method == "oracle" else None)
         truth0 = with_lag0(truth)
         tdec = actionshift.Decoder(truth0)  # privileged: the true tracked target, pre-FIFO decode
-        obs, _ = env.reset(seed=episode_seed(seed, ci, i))
+        obs, _ = env.reset(seed=episode_seed(seed, ce))
         policy.reset()
         adapter.begin_episode(adapter_episode_seed(seed, ce))
         emitted_hist = np.zeros((4, 7))

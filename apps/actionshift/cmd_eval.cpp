@@ -1,5 +1,7 @@
 #include "cmd_eval.hpp"
 
+#include "actionshift/eval/experiment.hpp"
+
 #include "commands.hpp"
 
 #include "actionshift/core/error.hpp"
@@ -210,11 +212,14 @@ int run_gate_promote(const GatePromoteOptions& o, std::ostream& out, std::ostrea
     if (!o.verdict_file.empty()) check_output_file(o.verdict_file, "--verdict");
     const eval::ResultSet rs = eval::load_results(o.results_dir);
     for (const auto& note : rs.notes) err << "actionshift: note: " << note << "\n";
-    const json j = eval::promotion_report(rs.records, o.candidate, o.baseline);
+    // cells are keyed by the canonical variant label: `entropy_probes{budget=6}` is `entropy_probes`
+    const std::string candidate = eval::canonical_method_label(o.candidate), baseline = eval::canonical_method_label(o.baseline);
+    if (candidate == baseline) throw InputError("gate promote", "--candidate/--baseline", "both name " + candidate + ": give two different methods");
+    const json j = eval::promotion_report(rs.records, candidate, baseline);
     if (j["cells"].empty())
-      throw InputError(o.results_dir, "", "no (task, split) cell holds records of both " + o.candidate + " and " + o.baseline);
+      throw InputError(o.results_dir, "", "no (task, split) cell holds records of both " + candidate + " and " + baseline);
     const std::string path = o.verdict_file.empty()
-                                 ? (fs::path(o.results_dir) / ("promotion." + o.candidate + ".vs." + o.baseline + ".json")).string()
+                                 ? (fs::path(o.results_dir) / ("promotion." + candidate + ".vs." + baseline + ".json")).string()
                                  : o.verdict_file;
     ensure_parent(path);
     eval::write_json_atomic(path, j);

@@ -146,7 +146,10 @@ int main(int argc, char** argv) {
   const auto add_job_options = [&](CLI::App* cmd, cli::CliJobOptions& j, bool required) {
     auto* task = cmd->add_option("--task", j.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
     auto* split = cmd->add_option("--split", j.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
-    auto* method = cmd->add_option("--method", j.request.method.name, "Adapter method (docs/adapters.md): " + method_list);
+    auto* method = cmd->add_option("--method", j.request.method.name,
+                                   "Adapter method (docs/adapters.md): " + method_list +
+                                       ". A bare name runs the paper's method; a variant is NAME{VARIANT} or NAME{KEY=VALUE,...} "
+                                       "(quote it for the shell), e.g. 'entropy_probes{calibrated}'");
     if (required) {
       task->required();
       split->required();
@@ -155,7 +158,9 @@ int main(int argc, char** argv) {
     cmd->add_option("--params", j.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
         ->capture_default_str();
     cmd->add_option("--seed", j.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
-    cmd->add_option("--episodes", j.request.episodes, "Episodes (dealt round-robin over the split's contracts)")
+    cmd->add_option("--episodes", j.request.episodes,
+                    "Episodes, dealt in blocks over the split's contracts: each contract once per block, in a seeded order, "
+                    "every contract of a block from the same initial state")
         ->capture_default_str();
     cmd->add_option("--backbone", j.request.backbone, "Frozen policy: expert, mlp, external:<command>, ...")
         ->capture_default_str();

@@ -29,8 +29,10 @@ from ._native import (  # noqa: F401  (re-exported API)
     encode,
     load_manifest,
     method_needs_calibration,
+    method_label,
     method_needs_pool,
     method_params,
+    method_variants,
     methods,
     pool_sha256,
     selftest_library,
@@ -43,8 +45,8 @@ from ._native import (  # noqa: F401  (re-exported API)
 __all__ = [
     "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
     "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
-    "make_adapter", "make_vec", "method_needs_calibration", "method_needs_pool", "method_params",
-    "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
+    "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
+    "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
 ]
 
 PROFILES = ("maniskill", "ideal")
@@ -249,7 +251,8 @@ def make_vec(task="pick_cube", num_envs=2, contract=None, split=None, index=0, p
 
 
 def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None):
-    """An adapter by method name (``methods()``): ``begin_episode(seed)``, ``encode(canonical, R)``
+    """An adapter by method name (``methods()``) or variant label (``"entropy_probes{calibrated}"``,
+    ``method_variants()``; a bare name is the paper's method): ``begin_episode(seed)``, ``encode(canonical, R)``
     -> raw action, ``observe(raw, response, R)``. Belief methods use the task's built-in response
     calibration; pool methods need ``pool`` (a pool name such as ``"reference9"``, a manifest path,
     or a list of contracts); the oracle needs ``truth``. ``params``: method parameters (dict)."""

@@ -874,14 +874,15 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 // ---------------------------------------------------------------- adapters
 
 // an adapter by method name, with its task's calibration and (for pool methods) a pool
-std::unique_ptr<adapt::Adapter> make_adapter(const std::string& method, const std::string& task, py::object pool,
+std::unique_ptr<adapt::Adapter> make_adapter(const std::string& label, const std::string& task, py::object pool,
                                              py::object truth, py::object params) {
   (void)sim::parse_task(task);  // every method names a task, even those that do not read its calibration
   const std::string text =
       params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
-  const nlohmann::json parsed = parse_json_input(text, "method " + method, "params");
-  if (!parsed.is_object()) throw InputError("method " + method, "params", "not a JSON object");
-  const nlohmann::json p = adapt::resolve_method_params(method, parsed);
+  // a name or a variant label (entropy_probes{calibrated}), as on the command line
+  const eval::MethodEntry entry = eval::canonical_method(eval::MethodEntry{label, text});
+  const std::string& method = entry.name;
+  const nlohmann::json p = adapt::resolve_method_params(method, parse_json_input(entry.params, "method " + method, "params"));
   struct Holder {
     std::vector<Contract> pool;
     std::optional<Contract> truth;
@@ -1262,7 +1263,21 @@ PYBIND11_MODULE(_native, m) {
   m.def("method_needs_calibration", &adapt::method_needs_calibration, py::arg("method"));
   m.def("method_params", [](const std::string& method, py::object params) {
         return json_to_py(eval::resolved_method_params(method, params.is_none() ? "{}" : py_to_json(params, "params")));
-      }, py::arg("method"), py::arg("params") = py::none(), "The method's parameters with every default filled in.");
+      }, py::arg("method"), py::arg("params") = py::none(),
+        "The method's parameters with every default filled in (the paper's method); `method` may be a variant label.");
+  m.def("method_label", [](const std::string& method, py::object params) {
+        const eval::MethodEntry e = eval::canonical_method(eval::MethodEntry{method, params.is_none() ? "{}" : py_to_json(params, "params")});
+        return adapt::method_variant_label(e.name, adapt::resolve_method_params(e.name, parse_json_input(e.params, "method " + e.name, "params")));
+      }, py::arg("method"), py::arg("params") = py::none(),
+        "The canonical variant label records and summary cells carry: 'entropy_probes' (the paper's method), "
+        "'entropy_probes{calibrated}', 'dualabi{tau=0.5}'.");
+  m.def("method_variants", [] {
+        py::list out;
+        for (const auto& v : adapt::method_variants())
+          out.append(py::dict(py::arg("method") = v.method, py::arg("name") = v.name, py::arg("params") = json_to_py(canonical_dump(v.params)),
+                              py::arg("rationale") = v.rationale));
+        return out;
+      }, "The named method variants: method, name, the parameters they set, and why they exist.");
   m.def("tcp_rotation", [](py::handle obs, const std::string& task) {
         const auto s = slice_of(task);
         return mat_out(adapt::tcp_rotation(obs_vector(obs, s, task, "obs"), s.tcp));

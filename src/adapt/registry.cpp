@@ -3,6 +3,7 @@
 #include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/identifier.hpp"
 #include "actionshift/adapt/methods.hpp"
+#include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <set>
 #include <string>
 
 namespace actionshift::adapt {
@@ -41,14 +43,17 @@ nlohmann::json defaults(const std::string& m) {
   if (m == "osi" || m == "recurrent_osi") return {{"weights", "pick_cube"}, {"warmup", 8}};
   if (m == "probe_osi") return {{"weights", "pick_cube"}, {"warmup", 8}, {"budget", 6}, {"amplitude", 0.5}};
   nlohmann::json p = {{"budget", 6}, {"amplitude", 0.5}};
+  // the paper's probe rule by default: an unscaled, lag-blind preview and the pure argmin (the
+  // reference implementation's selection); the project's corrections are the named variant
+  // `calibrated` (method_variants())
   if (m == "entropy_probes" || m == "dualabi") {
-    p["calibrated_preview"] = true;
-    p["lag_aware_preview"] = true;
+    p["calibrated_preview"] = false;
+    p["lag_aware_preview"] = false;
     p["max_active"] = 32;
   }
   if (m == "entropy_probes") {
-    p["entropy_tolerance"] = 0.001;
-    p["motion_tiebreak"] = true;
+    p["entropy_tolerance"] = 0.0;
+    p["motion_tiebreak"] = false;
   }
   if (m == "dualabi") {
     p["tau"] = 1.5;  // frozen by the pilot on seeds 20260723/24 (docs/results/dualabi_pilot.md); the reference also froze 1.5
@@ -205,6 +210,182 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
     return std::make_unique<DualAbiAdapter>(*in.pool, *in.model, p.at("tau").get<double>(), probe_options(p),
                                             p.at("window").get<int>());
   throw InputError("method", method, "unknown method");
+}
+
+}  // namespace actionshift::adapt
+
+namespace actionshift::adapt {
+
+const std::vector<MethodVariant>& method_variants() {
+  static const std::vector<MethodVariant> v{
+      {"entropy_probes", "calibrated",
+       {{"calibrated_preview", true}, {"lag_aware_preview", true}, {"entropy_tolerance", 0.001}, {"motion_tiebreak", true}},
+       "previews each hypothesis as the calibrated response alpha*prediction through its own lag FIFO (the paper's "
+       "rule compares unscaled, lag-blind predictions with a scaled observation), and among probes within 0.001 nats "
+       "of the best sends the one that moves the arm least"},
+      {"dualabi", "calibrated",
+       {{"calibrated_preview", true}, {"lag_aware_preview", true}},
+       "previews each hypothesis as the calibrated response alpha*prediction through its own lag FIFO (the paper's "
+       "rule compares unscaled, lag-blind predictions with a scaled observation)"},
+  };
+  return v;
+}
+
+namespace {
+
+const MethodVariant* find_variant(const std::string& method, std::string_view name) {
+  for (const auto& v : method_variants())
+    if (v.method == method && v.name == name) return &v;
+  return nullptr;
+}
+
+std::string trim(std::string_view s) {
+  std::size_t a = 0, b = s.size();
+  while (a < b && (s[a] == ' ' || s[a] == '\t')) ++a;
+  while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t')) --b;
+  return std::string(s.substr(a, b - a));
+}
+
+// a label value: true/false, an integer, a decimal, a JSON string, or bare text
+nlohmann::json label_value(const std::string& text, const std::string& where) {
+  if (text.empty()) throw InputError("method", where, "missing value after '='");
+  if (text == "true") return true;
+  if (text == "false") return false;
+  if (text.front() == '"') {
+    try {
+      const auto j = nlohmann::json::parse(text);
+      if (j.is_string()) return j;
+    } catch (const nlohmann::json::exception&) {
+    }
+    throw InputError("method", where, "malformed quoted value " + quote_input(text));
+  }
+  const bool numeric = text.find_first_not_of("0123456789+-.eE") == std::string::npos &&
+                       text.find_first_of("0123456789") != std::string::npos;
+  if (numeric) {
+    try {
+      const auto j = nlohmann::json::parse(text);
+      if (j.is_number()) return j;
+    } catch (const nlohmann::json::exception&) {
+    }
+    throw InputError("method", where, "malformed number " + quote_input(text));
+  }
+  return text;
+}
+
+std::string label_text(const nlohmann::json& v) {
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_number_float()) return python_float_repr(v.get<double>());
+  if (v.is_number()) return v.dump();
+  if (v.is_string()) {
+    const auto s = v.get<std::string>();
+    const bool bare = !s.empty() && s != "true" && s != "false" && s.find_first_of(",{}=\" ") == std::string::npos &&
+                      s.find_first_not_of("0123456789+-.eE") != std::string::npos;
+    return bare ? s : v.dump();
+  }
+  return v.dump();
+}
+
+// equal as parameter values: numbers by value (0 and 0.0 alike), everything else exactly
+bool same_value(const nlohmann::json& a, const nlohmann::json& b) {
+  if (a.is_number() && b.is_number()) return a.get<double>() == b.get<double>();
+  return a == b;
+}
+
+}  // namespace
+
+MethodLabel parse_method_label(std::string_view label) {
+  MethodLabel out;
+  const std::size_t open = label.find('{');
+  if (open == std::string_view::npos) {
+    if (label.find('}') != std::string_view::npos) throw InputError("method", printable_input(label), "'}' without '{'");
+    out.name = std::string(label);
+    return out;
+  }
+  if (label.back() != '}') throw InputError("method", printable_input(label), "a label's parameters end with '}'");
+  out.name = std::string(label.substr(0, open));
+  if (out.name.empty()) throw InputError("method", printable_input(label), "no method name before '{'");
+  const std::string_view body = label.substr(open + 1, label.size() - open - 2);
+  // split at commas outside quotes
+  std::vector<std::string> items;
+  std::string cur;
+  bool quoted = false;
+  for (std::size_t i = 0; i < body.size(); ++i) {
+    const char c = body[i];
+    if (c == '"' && (i == 0 || body[i - 1] != '\\')) quoted = !quoted;
+    if (c == ',' && !quoted) {
+      items.push_back(trim(cur));
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (quoted) throw InputError("method", printable_input(label), "unterminated quoted value");
+  items.push_back(trim(cur));
+  if (items.size() == 1 && items[0].empty()) return out;  // name{}: the defaults
+  std::set<std::string> explicit_keys;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const std::string& item = items[i];
+    if (item.empty()) throw InputError("method", printable_input(label), "empty item between commas");
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || (item.front() == '"')) {
+      const MethodVariant* v = find_variant(out.name, item);
+      if (!v) {
+        std::string known;
+        for (const auto& mv : method_variants())
+          if (mv.method == out.name) known += (known.empty() ? "" : ", ") + mv.name;
+        throw InputError("method " + out.name, printable_input(item),
+                         known.empty() ? "unknown variant (this method has no named variants; give key=value)"
+                                       : "unknown variant (known: " + known + ")");
+      }
+      if (i != 0) throw InputError("method " + out.name, item, "a named variant comes first in the label");
+      for (auto it = v->params.begin(); it != v->params.end(); ++it) out.params[it.key()] = it.value();
+      continue;
+    }
+    const std::string key = trim(item.substr(0, eq));
+    if (key.empty()) throw InputError("method " + out.name, printable_input(item), "missing parameter name before '='");
+    const nlohmann::json value = label_value(trim(item.substr(eq + 1)), key);
+    // a key the variant set may be overridden; a key given twice may not
+    if (!explicit_keys.insert(key).second) throw InputError("method " + out.name, key, "given twice in the label");
+    out.params[key] = value;
+  }
+  return out;
+}
+
+nlohmann::json merge_method_params(const MethodLabel& label, const nlohmann::json& explicit_params) {
+  if (!explicit_params.is_object()) throw InputError("method " + label.name, "params", "not a JSON object");
+  nlohmann::json out = label.params;
+  for (auto it = explicit_params.begin(); it != explicit_params.end(); ++it) {
+    if (out.contains(it.key()) && !same_value(out[it.key()], it.value()))
+      throw InputError("method " + label.name, it.key(),
+                       "set to " + label_text(out[it.key()]) + " by the label and to " + label_text(it.value()) + " by params");
+    out[it.key()] = it.value();
+  }
+  return out;
+}
+
+std::string method_variant_label(const std::string& method, const nlohmann::json& p) {
+  const nlohmann::json d = defaults(method);
+  // the variant whose every parameter matches and that sets the most
+  const MethodVariant* best = nullptr;
+  for (const auto& v : method_variants()) {
+    if (v.method != method) continue;
+    bool all = true;
+    for (auto it = v.params.begin(); it != v.params.end() && all; ++it) all = p.contains(it.key()) && same_value(p[it.key()], it.value());
+    if (all && (!best || v.params.size() > best->params.size())) best = &v;
+  }
+  std::vector<std::string> items;
+  if (best) items.push_back(best->name);
+  for (auto it = p.begin(); it != p.end(); ++it) {  // nlohmann objects iterate in sorted key order
+    const nlohmann::json* base = nullptr;
+    if (best && best->params.contains(it.key())) base = &best->params[it.key()];
+    else if (d.contains(it.key())) base = &d[it.key()];
+    if (base && same_value(*base, it.value())) continue;
+    items.push_back(it.key() + "=" + label_text(it.value()));
+  }
+  if (items.empty()) return method;
+  std::string out = method + "{";
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
+  return out + "}";
 }
 
 }  // namespace actionshift::adapt

@@ -205,11 +205,6 @@ std::string key_text(const PairKey& k) {
 }
 
 // the summary owns the rule that names a record's cell (its method label): deriving the key through
-// summarize_records keeps compare's cells exactly the summary's
-CellKey cell_key_of(const EpisodeRecord& r) {
-  const std::vector<EpisodeRecord> one{r};
-  return summarize_records(one).front().key;
-}
 
 json cell_json(const CellSummary& c, const PaperNumbers& paper) {
   const double n = static_cast<double>(c.episodes);
@@ -491,7 +486,7 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
   }
   const std::vector<CellSummary> cells = summarize_records(records);
   std::map<CellKey, std::vector<EpisodeRecord>> by_cell;
-  for (const auto& r : records) by_cell[cell_key_of(r)].push_back(r);
+  for (const auto& r : records) by_cell[cell_key(r)].push_back(r);
 
   json dirs = json::array();
   for (const auto& d : inputs.directories)

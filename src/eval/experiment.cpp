@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -57,8 +58,33 @@ adapt::ResponseCalibration builtin_selftest_calibration(const std::string& task,
   return adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + profile + "/selftest/" + task);
 }
 
+MethodEntry canonical_method(const MethodEntry& m) {
+  const adapt::MethodLabel label = adapt::parse_method_label(m.name);
+  return MethodEntry{label.name, canonical_dump(adapt::merge_method_params(label, parse_params(m.params, label.name)))};
+}
+
 std::string resolved_method_params(const std::string& method, const std::string& params_json) {
-  return canonical_dump(adapt::resolve_method_params(method, parse_params(params_json, method)));
+  const MethodEntry m = canonical_method(MethodEntry{method, params_json});
+  return canonical_dump(adapt::resolve_method_params(m.name, parse_params(m.params, m.name)));
+}
+
+std::string canonical_method_label(const std::string& label) {
+  const MethodEntry m = canonical_method(MethodEntry{label, "{}"});
+  const auto& known = adapt::method_names();
+  if (std::find(known.begin(), known.end(), m.name) == known.end()) return label;  // not ours to canonicalize
+  return adapt::method_variant_label(m.name, adapt::resolve_method_params(m.name, parse_params(m.params, m.name)));
+}
+
+std::string method_variant(const JobSpec& job) {
+  const auto& known = adapt::method_names();
+  const nlohmann::json params = parse_params(job.method_params, job.method);
+  if (std::find(known.begin(), known.end(), job.method) != known.end())
+    return adapt::method_variant_label(job.method, adapt::resolve_method_params(job.method, params));
+  // a method outside the registry (a test's stand-in): every parameter it has is part of its label
+  std::string items;
+  for (auto it = params.begin(); it != params.end(); ++it)
+    items += (items.empty() ? "" : ",") + it.key() + "=" + (it.value().is_string() ? it.value().get<std::string>() : canonical_dump(it.value()));
+  return items.empty() ? job.method : job.method + "{" + items + "}";
 }
 
 PlanResolver default_resolver() {
@@ -80,6 +106,7 @@ PlanResolver default_resolver() {
     if (!adapt::method_needs_calibration(m.name)) return std::nullopt;
     return builtin_calibration(task, profile).sha256();
   };
+  r.canonical_method = [](const MethodEntry& m) { return canonical_method(m); };
   r.check_method = [](const MethodEntry& m) { adapt::resolve_method_params(m.name, parse_params(m.params, m.name)); };
   r.method_params = [](const MethodEntry& m) { return resolved_method_params(m.name, m.params); };
   r.method_uses_pool = [](const MethodEntry& m) { return adapt::method_needs_pool(m.name); };

@@ -376,9 +376,9 @@ json promotion_report(const std::vector<EpisodeRecord>& records, const std::stri
   // group by (task, split, backbone); keep cells where both methods ran
   std::map<std::string, std::pair<std::vector<EpisodeRecord>, std::vector<EpisodeRecord>>> cells;
   for (const auto& r : records) {
-    if (r.method != candidate && r.method != baseline) continue;
+    if (r.method_variant != candidate && r.method_variant != baseline) continue;
     const std::string key = r.task + "/" + r.split + (r.backbone == "expert" ? "" : "/" + r.backbone);
-    (r.method == candidate ? cells[key].first : cells[key].second).push_back(r);
+    (r.method_variant == candidate ? cells[key].first : cells[key].second).push_back(r);
   }
   json j = {{"schema_version", "1.0"},
             {"gate", "promotion"},

@@ -252,12 +252,6 @@ std::string files_content_sha256(const std::vector<std::string>& paths, const st
 std::string jsonl_file_name(std::string_view id) { return std::string(id) + ".jsonl"; }
 std::string summary_file_name(std::string_view id) { return std::string(id) + ".summary.json"; }
 
-EpisodeSlot episode_slot(std::int64_t contracts, std::int64_t episode_index) {
-  if (contracts <= 0) throw std::invalid_argument("episode_slot: contracts must be > 0");
-  if (episode_index < 0) throw std::invalid_argument("episode_slot: episode_index must be >= 0");
-  return {episode_index % contracts, episode_index / contracts};
-}
-
 std::uint64_t splitmix64(std::uint64_t x) noexcept {
   std::uint64_t z = x + 0x9E3779B97F4A7C15ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -265,15 +259,37 @@ std::uint64_t splitmix64(std::uint64_t x) noexcept {
   return z ^ (z >> 31);
 }
 
+std::vector<std::int64_t> deal_permutation(std::uint64_t seed, std::int64_t contracts, std::int64_t block) {
+  if (contracts <= 0) throw std::invalid_argument("deal_permutation: contracts must be > 0");
+  if (block < 0) throw std::invalid_argument("deal_permutation: block must be >= 0");
+  constexpr std::uint64_t kDealDomain = 0x6465616c696e67ull;  // "dealing"
+  std::uint64_t state = splitmix64(splitmix64(seed ^ kDealDomain) ^ static_cast<std::uint64_t>(block));
+  std::vector<std::int64_t> perm(static_cast<std::size_t>(contracts));
+  for (std::int64_t k = 0; k < contracts; ++k) perm[static_cast<std::size_t>(k)] = k;
+  for (std::int64_t j = contracts - 1; j > 0; --j) {
+    state = splitmix64(state);
+    const auto k = static_cast<std::int64_t>(state % static_cast<std::uint64_t>(j + 1));
+    std::swap(perm[static_cast<std::size_t>(j)], perm[static_cast<std::size_t>(k)]);
+  }
+  return perm;
+}
+
+EpisodeSlot episode_slot(std::uint64_t seed, std::int64_t contracts, std::int64_t episode_index) {
+  if (contracts <= 0) throw std::invalid_argument("episode_slot: contracts must be > 0");
+  if (episode_index < 0) throw std::invalid_argument("episode_slot: episode_index must be >= 0");
+  const std::int64_t block = episode_index / contracts;
+  const auto perm = deal_permutation(seed, contracts, block);
+  return {perm[static_cast<std::size_t>(episode_index % contracts)], block};
+}
+
 std::uint64_t adapter_episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept {
   constexpr std::uint64_t kAdapterDomain = 0x61646170746572ull;  // "adapter"
   return splitmix64(splitmix64(seed ^ kAdapterDomain) ^ static_cast<std::uint64_t>(contract_episode));
 }
 
-std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept {
-  std::uint64_t h = splitmix64(seed);
-  h = splitmix64(h ^ static_cast<std::uint64_t>(contract_index));
-  return splitmix64(h ^ static_cast<std::uint64_t>(episode_index));
+std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept {
+  constexpr std::uint64_t kInitialStateDomain = 0x696e6974737461ull;  // "initsta"
+  return splitmix64(splitmix64(splitmix64(seed) ^ kInitialStateDomain) ^ static_cast<std::uint64_t>(contract_episode));
 }
 
 }  // namespace actionshift::eval

@@ -225,7 +225,7 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     const YAML::Node m = methods[i];
     MethodEntry entry;
     if (m.IsScalar()) {
-      entry.name = require_token(m, source, f);
+      entry.name = require_string(m, source, f);  // a name or a label, e.g. entropy_probes{calibrated}
     } else if (m.IsMap()) {
       std::set<std::string> entry_keys;
       for (const auto& kv : m) {
@@ -235,7 +235,7 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
         if (!entry_keys.insert(key).second) throw InputError(at_line(source, kv.first), f + "." + key, "duplicate key");
       }
       if (!m["name"]) throw InputError(at_line(source, m), f + ".name", "missing required key");
-      entry.name = require_token(m["name"], source, f + ".name");
+      entry.name = require_string(m["name"], source, f + ".name");
       if (m["params"] && !m["params"].IsNull()) {
         if (!m["params"].IsMap()) throw InputError(at_line(source, m["params"]), f + ".params", "expected a mapping");
         entry.params = canonical_dump(to_json_value(m["params"], source, f + ".params"));
@@ -309,15 +309,16 @@ Experiment load_experiment(const std::string& path) {
 JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("resolve_job: resolver needs split and backbone");
   if (q.pool && !resolver.pool) throw InputError(q.source, "pool", "pools cannot be resolved here");
-  if (resolver.check_method) resolver.check_method(q.method);
+  const MethodEntry method = resolver.canonical_method ? resolver.canonical_method(q.method) : q.method;
+  if (resolver.check_method) resolver.check_method(method);
   JobSpec job;
   job.task = q.task;
   job.split = resolver.split(q.task, q.split);
-  job.method = q.method.name;
-  job.method_params = resolver.method_params ? resolver.method_params(q.method) : q.method.params;
+  job.method = method.name;
+  job.method_params = resolver.method_params ? resolver.method_params(method) : method.params;
   job.backbone = resolver.backbone(q.task, q.backbone);
-  if (q.pool && (!resolver.method_uses_pool || resolver.method_uses_pool(q.method))) job.pool = resolver.pool(*q.pool);
-  job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, q.method, q.profile) : std::nullopt;
+  if (q.pool && (!resolver.method_uses_pool || resolver.method_uses_pool(method))) job.pool = resolver.pool(*q.pool);
+  job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, method, q.profile) : std::nullopt;
   job.rotation_mode = q.rotation_mode;
   job.profile = q.profile;
   job.seed = q.seed;
@@ -361,9 +362,13 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
     pools[split_name] = name ? std::optional<PoolRef>(in_experiment(ex, field, [&] { return resolver.pool(*name); })) : std::nullopt;
   }
   const auto method_field = [](std::size_t i) { return "methods[" + std::to_string(i) + "]"; };
+  std::vector<MethodEntry> methods = ex.methods;
+  if (resolver.canonical_method)
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      methods[i] = in_experiment(ex, method_field(i), [&] { return resolver.canonical_method(ex.methods[i]); });
   if (resolver.check_method)
-    for (std::size_t i = 0; i < ex.methods.size(); ++i)
-      in_experiment(ex, method_field(i), [&] { resolver.check_method(ex.methods[i]); });
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      in_experiment(ex, method_field(i), [&] { resolver.check_method(methods[i]); });
   std::set<std::string> ids;
   for (std::size_t t = 0; t < ex.tasks.size(); ++t) {
     const std::string& task = ex.tasks[t];
@@ -375,8 +380,8 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
       const std::string& split_name = ex.splits[s];
       const SplitRef split =
           in_experiment(ex, "splits[" + std::to_string(s) + "]", [&] { return resolver.split(task, split_name); });
-      for (std::size_t m = 0; m < ex.methods.size(); ++m) {
-        const MethodEntry& method = ex.methods[m];
+      for (std::size_t m = 0; m < methods.size(); ++m) {
+        const MethodEntry& method = methods[m];
         const std::optional<std::string> calibration =
             resolver.calibration
                 ? in_experiment(ex, method_field(m), [&] { return resolver.calibration(task, method, ex.profile); })

@@ -21,7 +21,7 @@ using nlohmann::json;
 const std::set<std::string>& record_keys() {
   static const std::set<std::string> keys = {
       "backbone",       "backbone_sha256", "contract_index",     "contract_sha256", "episode_index",
-      "job_id",         "method",          "probe_displacement", "probe_steps",     "profile",    "return", "obs_noise",
+      "job_id",         "method",          "method_variant",     "probe_displacement", "probe_steps",     "profile",    "return", "obs_noise",
       "safety_flags",   "schema_version",  "seed",               "split",           "steps",
       "success_at_end", "success_once",    "task",               "provenance"};
   return keys;
@@ -80,6 +80,15 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
   }
   if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got " + quote_input(r.split, '"') + ")");
   if (!detail::is_token(r.method)) throw InputError(src, "method", "expected a name of [a-z0-9_.-] (got " + quote_input(r.method, '"') + ")");
+  if (r.method_variant.empty() || r.method_variant.size() > 512)
+    throw InputError(src, "method_variant", "must be a label of 1 to 512 characters");
+  for (char c : r.method_variant)
+    if (static_cast<unsigned char>(c) < 0x20) throw InputError(src, "method_variant", "contains a control character");
+  if (r.method_variant.compare(0, r.method.size(), r.method) != 0 ||
+      (r.method_variant.size() > r.method.size() && r.method_variant[r.method.size()] != '{'))
+    throw InputError(src, "method_variant",
+                     "must be the method's name, or its name followed by {...} (got " + quote_input(r.method_variant, '"') + " for method " +
+                         quote_input(r.method, '"') + ")");
   if (r.contract_index < 0) throw InputError(src, "contract_index", "must be >= 0");
   if (!is_sha256_hex(r.contract_sha256))
     throw InputError(src, "contract_sha256", "expected 64 lowercase hex digits (got " + quote_input(r.contract_sha256, '"') + ")");
@@ -112,6 +121,7 @@ nlohmann::json to_json(const EpisodeRecord& r) {
   j["task"] = r.task;
   j["split"] = r.split;
   j["method"] = r.method;
+  j["method_variant"] = r.method_variant;
   j["seed"] = r.seed;
   j["contract_index"] = r.contract_index;
   j["contract_sha256"] = r.contract_sha256;
@@ -144,10 +154,17 @@ EpisodeRecord record_from_json(const nlohmann::json& j, const std::string& src) 
     if (!record_keys().count(it.key())) throw InputError(src, it.key(), "unknown field");
   EpisodeRecord r;
   r.schema_version = get_string(j, "schema_version", src);
+  if (r.schema_version.size() > 1 && r.schema_version.compare(0, 2, "1.") == 0)
+    throw InputError(src, "schema_version",
+                     "is " + quote_input(r.schema_version, '"') +
+                         ": written before paired initial states and method variants (schema 2.0); its episodes were dealt and "
+                         "seeded differently and its entropy_probes/dualabi ran another rule, so it cannot be mixed with "
+                         "today's records: re-run the job");
   r.job_id = get_string(j, "job_id", src);
   r.task = get_string(j, "task", src);
   r.split = get_string(j, "split", src);
   r.method = get_string(j, "method", src);
+  r.method_variant = get_string(j, "method_variant", src);
   r.seed = get_u64(j, "seed", src);
   r.contract_index = get_count(j, "contract_index", src);
   r.contract_sha256 = get_string(j, "contract_sha256", src);

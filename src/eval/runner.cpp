@@ -2,6 +2,7 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/workers.hpp"
+#include "actionshift/eval/experiment.hpp"
 #include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/store.hpp"
 #include "io.hpp"
@@ -93,13 +94,13 @@ EpisodeTask episode_task(const JobSpec& job, std::int64_t episode_index, unsigne
   if (episode_index < 0 || episode_index >= job.episodes)
     throw std::invalid_argument("episode " + std::to_string(episode_index) + " is outside the job's " +
                                 std::to_string(job.episodes) + " episodes");
-  const auto slot = episode_slot(job.split.contracts, episode_index);
+  const auto slot = episode_slot(job.seed, job.split.contracts, episode_index);
   return EpisodeTask{&job,
                      job.seed,
                      slot.contract_index,
                      slot.contract_episode,
                      episode_index,
-                     episode_seed(job.seed, slot.contract_index, episode_index),
+                     episode_seed(job.seed, slot.contract_episode),
                      adapter_episode_seed(job.seed, slot.contract_episode),
                      worker};
 }
@@ -110,6 +111,7 @@ void stamp_record(EpisodeRecord& r, const JobSpec& job, const std::string& job_i
   r.task = job.task;
   r.split = job.split.name;
   r.method = job.method;
+  r.method_variant = method_variant(job);
   r.seed = job.seed;
   r.contract_index = task.contract_index;
   r.episode_index = task.episode_index;

@@ -1,5 +1,7 @@
 #include "actionshift/eval/store.hpp"
 
+#include "actionshift/eval/experiment.hpp"
+
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
@@ -62,12 +64,13 @@ void check_record_belongs(const EpisodeRecord& r, const JobSpec& job, const std:
   if (r.task != job.task) differs("task", r.task, job.task);
   if (r.split != job.split.name) differs("split", r.split, job.split.name);
   if (r.method != job.method) differs("method", r.method, job.method);
+  if (const std::string v = method_variant(job); r.method_variant != v) differs("method_variant", r.method_variant, v);
   if (r.seed != job.seed) differs("seed", std::to_string(r.seed), std::to_string(job.seed));
   if (r.backbone != job.backbone.name) differs("backbone", r.backbone, job.backbone.name);
   if (r.backbone_sha256 != job.backbone.sha256) differs("backbone_sha256", r.backbone_sha256, job.backbone.sha256);
   if (r.profile != job.profile) differs("profile", r.profile, job.profile);
   if (r.obs_noise != job.obs_noise) differs("obs_noise", std::to_string(r.obs_noise), std::to_string(job.obs_noise));
-  const auto slot = episode_slot(job.split.contracts, episode_index);
+  const auto slot = episode_slot(job.seed, job.split.contracts, episode_index);
   if (r.contract_index != slot.contract_index)
     throw InputError(src, "contract_index", "expected " + std::to_string(slot.contract_index) + " for episode " +
                                                 std::to_string(episode_index) + " (got " +

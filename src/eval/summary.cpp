@@ -91,6 +91,8 @@ ResultSet load_results(const std::string& dir) {
   return out;
 }
 
+CellKey cell_key(const EpisodeRecord& r) { return CellKey{r.task, r.split, r.method_variant, r.backbone}; }
+
 std::vector<CellSummary> summarize_records(const std::vector<EpisodeRecord>& records) {
   struct Acc {
     std::int64_t n{0}, once{0}, at_end{0}, steps{0}, probe_steps{0}, flagged{0};
@@ -102,11 +104,11 @@ std::vector<CellSummary> summarize_records(const std::vector<EpisodeRecord>& rec
   };
   std::map<CellKey, Acc> cells;
   for (const auto& r : records) {
-    Acc& a = cells[CellKey{r.task, r.split, r.method, r.backbone}];
+    Acc& a = cells[cell_key(r)];
     const PairKey k{r.seed, r.contract_index, r.episode_index};
     const auto [it, inserted] = a.keys.emplace(k, r.job_id);
     if (!inserted)
-      throw InputError("results", r.task + "/" + r.split + "/" + r.method,
+      throw InputError("results", r.task + "/" + r.split + "/" + r.method_variant,
                        "episode (seed " + std::to_string(k.seed) + ", contract " + std::to_string(k.contract_index) +
                            ", episode " + std::to_string(k.episode_index) + ") appears in jobs " +
                            it->second.substr(0, 12) + " and " + r.job_id.substr(0, 12) +

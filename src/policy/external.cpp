@@ -261,8 +261,8 @@ void ExternalPolicy::reset() {
   ++episode_;
   step_ = 0;
   const sim::ObservationLayout& layout = sim::observation_layout(task_);
+  // no episode index: with one worker it would name the job's episode, and from it the dealt contract
   nlohmann::json msg = {{"type", "reset"},
-                        {"episode", episode_},
                         {"task", std::string(sim::task_name(task_))},
                         {"layout", nlohmann::json::parse(layout.to_json())}};
   send(msg.dump(), "reset", options_.step_timeout_s);

@@ -101,7 +101,11 @@ struct SelfTest::Impl {
   Impl(const Options& o, std::vector<Contract> declared)
       : opt(o), pool(std::move(declared)), belief(pool, o.model), candidates(adapt::probe_candidates(o.amplitude)) {
     preview.budget = o.budget;
-    preview.amplitude = o.amplitude;  // calibrated, lag-aware preview (adapt::ProbeOptions defaults)
+    preview.amplitude = o.amplitude;
+    // the self-test previews as the project's `calibrated` variant does (docs/adapters.md): α-scaled,
+    // through each hypothesis's lag FIFO; the benchmark's methods default to the paper's rule instead
+    preview.calibrated_preview = true;
+    preview.lag_aware_preview = true;
   }
 
   // the next probe: fixed pulses, or the entropy-minimising axis pulse among the admissible ones:

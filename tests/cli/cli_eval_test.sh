@@ -118,6 +118,48 @@ run "$AS" gate promote --candidate oracle --baseline no_adapt --results "$TMP/sm
 expect_rc 0 "gate promote"
 expect_out "extend_seeds" "one seed: more seeds needed"
 
+# ---- method variants: the bare name is the paper's rule; a variant is its own job and its own cell
+run "$AS" run --task pick_cube --split reference_seen --method entropy_probes --pool reference9 --episodes 4 --out "$TMP/var" --progress off
+expect_rc 0 "run entropy_probes (the paper's rule)"
+run "$AS" run --task pick_cube --split reference_seen --method 'entropy_probes{calibrated}' --pool reference9 --episodes 4 --out "$TMP/var" --progress off
+expect_rc 0 "run entropy_probes{calibrated}"
+[ "$(ls "$TMP"/var/*.jsonl | wc -l)" = 2 ] && ok || bad "two variants should be two jobs"
+# the variant spelled out parameter by parameter is the same job
+run "$AS" run --task pick_cube --split reference_seen --method entropy_probes --pool reference9 --episodes 4 --out "$TMP/var" --progress off \
+  --params '{"calibrated_preview":true,"lag_aware_preview":true,"entropy_tolerance":0.001,"motion_tiebreak":true}'
+expect_out "already complete" "a spelled-out variant is the named variant's job"
+python3 - "$TMP/var" <<'PY' && ok || bad "the default job does not run the paper's rule, or its records do not carry the variant"
+import glob, json, sys
+d = sys.argv[1]
+variants = {}
+for f in glob.glob(d + "/*.summary.json"):
+    s = json.load(open(f))
+    p = s["job"]["method"]["params"]
+    recs = [json.loads(l) for l in open(f.replace(".summary.json", ".jsonl"))]
+    variants[recs[0]["method_variant"]] = p
+    assert all(r["method"] == "entropy_probes" for r in recs)
+assert set(variants) == {"entropy_probes", "entropy_probes{calibrated}"}, variants
+ref = variants["entropy_probes"]
+assert (ref["calibrated_preview"], ref["lag_aware_preview"], ref["entropy_tolerance"], ref["motion_tiebreak"]) == (False, False, 0.0, False), ref
+cal = variants["entropy_probes{calibrated}"]
+assert (cal["calibrated_preview"], cal["lag_aware_preview"], cal["entropy_tolerance"], cal["motion_tiebreak"]) == (True, True, 0.001, True), cal
+PY
+run "$AS" summarize "$TMP/var" --json
+expect_rc 0 "summarize two variants"
+[ "$(echo "$OUT" | python3 -c 'import json,sys; print(sorted(c["method"] for c in json.load(sys.stdin)["cells"]))')" = "['entropy_probes', 'entropy_probes{calibrated}']" ] \
+  && ok || bad "two variants of one method should summarize to two cells"
+run "$AS" gate promote --candidate 'entropy_probes{calibrated_preview=true,lag_aware_preview=true,entropy_tolerance=0.001,motion_tiebreak=true}' \
+  --baseline entropy_probes --results "$TMP/var"
+expect_rc 0 "gate promote between two variants (the candidate spelled out)"
+[ -e "$TMP/var/promotion.entropy_probes{calibrated}.vs.entropy_probes.json" ] && ok || bad "the verdict file should carry the canonical labels"
+run "$AS" run --task pick_cube --split reference_seen --method 'entropy_probes{precise}' --pool reference9 --out "$TMP/x" --progress off
+expect_rc 2 "unknown variant"
+expect_one_line_error "unknown variant"
+expect_err "unknown variant (known: calibrated)" "unknown variant message"
+run "$AS" run --task pick_cube --split reference_seen --method 'entropy_probes{budget=3}' --params '{"budget":4}' --pool reference9 --out "$TMP/x" --progress off
+expect_rc 2 "label and params disagree"
+expect_one_line_error "label and params disagree"
+
 # ---- bad input: one line, exit 2, nothing written over
 run "$AS" run --task pick_cube --split seen --method telepathy --out "$TMP/x" --progress off
 expect_rc 2 "unknown method"

@@ -35,7 +35,7 @@ TEST(JobSpec, CanonicalJsonIsPinned) {
   const std::string expected =
       "{\"backbone\":{\"name\":\"expert\",\"sha256\":\"" + std::string(64, 'b') +
       "\"},\"calibration_sha256\":null,\"episodes\":256,\"method\":{\"name\":\"oracle\",\"params\":{}},"
-      "\"pool\":null,\"profile\":\"maniskill\",\"rotation_mode\":\"live\",\"schema_version\":\"2.0\",\"seed\":20260718,"
+      "\"pool\":null,\"profile\":\"maniskill\",\"rotation_mode\":\"live\",\"schema_version\":\"3.0\",\"seed\":20260718,"
       "\"split\":{\"contracts\":2,\"name\":\"seen\",\"sha256\":\"" + std::string(64, 'a') + "\"},\"task\":\"pick_cube\"}";
   EXPECT_EQ(job_canonical_json(golden_job()), expected);
   EXPECT_EQ(job_id(golden_job()), sha256_hex(expected));
@@ -44,7 +44,7 @@ TEST(JobSpec, CanonicalJsonIsPinned) {
 TEST(JobSpec, IdIsStable) {
   // golden: computed independently with Python json.dumps(obj, sort_keys=True, separators=(",",":"))
   // + hashlib.sha256; changes only with a deliberate schema change
-  EXPECT_EQ(job_id(golden_job()), "f0052a82b78ea3758c53f716282ca843abb666b8acdb64ec835a8b69d3c6b5dd");
+  EXPECT_EQ(job_id(golden_job()), "e59abadf5e6c68cb630ee3b2bea3904e04e12f82e58413eec1e20b5274f7006e");
 }
 
 TEST(JobSpec, ProfilesAreTheSimulatorsAndUnknownOnesAreRejected) {
@@ -137,7 +137,7 @@ TEST(JobSpec, ObsNoiseEntersTheSpecAndTheIdOnlyWhenNonZero) {
   JobSpec j = golden_job();
   j.obs_noise = 0.0;  // off: the spec, its canonical text and its id are those of every earlier job
   EXPECT_FALSE(job_to_json(j).contains("obs_noise"));
-  EXPECT_EQ(job_id(j), "f0052a82b78ea3758c53f716282ca843abb666b8acdb64ec835a8b69d3c6b5dd");
+  EXPECT_EQ(job_id(j), "e59abadf5e6c68cb630ee3b2bea3904e04e12f82e58413eec1e20b5274f7006e");
   j.obs_noise = 0.005;
   EXPECT_THAT(job_canonical_json(j), HasSubstr("\"obs_noise\":0.005,"));
   EXPECT_NE(job_id(j), job_id(golden_job()));
@@ -166,40 +166,68 @@ TEST(JobSpec, FileNamesUseTheFullId) {
   EXPECT_EQ(summary_file_name(id), id + ".summary.json");
 }
 
-TEST(EpisodeLayout, RoundRobinOverContracts) {
-  EXPECT_EQ(episode_slot(3, 0).contract_index, 0);
-  EXPECT_EQ(episode_slot(3, 4).contract_index, 1);
-  EXPECT_EQ(episode_slot(3, 4).contract_episode, 1);
-  EXPECT_EQ(episode_slot(3, 8).contract_index, 2);
-  EXPECT_EQ(episode_slot(3, 8).contract_episode, 2);
+TEST(EpisodeLayout, EveryContractOncePerBlockInASeededOrder) {
+  // each block of n episodes runs every contract once; the order within a block is a permutation
+  for (std::int64_t n : {1, 3, 32}) {
+    for (std::int64_t b = 0; b < 5; ++b) {
+      std::set<std::int64_t> seen;
+      for (std::int64_t p = 0; p < n; ++p) {
+        const auto slot = episode_slot(20260718, n, b * n + p);
+        EXPECT_EQ(slot.contract_episode, b);
+        seen.insert(slot.contract_index);
+      }
+      EXPECT_EQ(static_cast<std::int64_t>(seen.size()), n);
+      EXPECT_EQ(*seen.begin(), 0);
+      EXPECT_EQ(*seen.rbegin(), n - 1);
+    }
+  }
   std::vector<int> per(3, 0);
-  for (int i = 0; i < 256; ++i) ++per[static_cast<std::size_t>(episode_slot(3, i).contract_index)];
-  EXPECT_EQ(per, (std::vector<int>{86, 85, 85}));
-  EXPECT_THROW(episode_slot(0, 1), std::invalid_argument);
+  for (int i = 0; i < 256; ++i) ++per[static_cast<std::size_t>(episode_slot(20260718, 3, i).contract_index)];
+  for (int c : per) EXPECT_TRUE(c == 85 || c == 86) << c;
+  EXPECT_EQ(per[0] + per[1] + per[2], 256);
+  // the order is not round-robin and differs between blocks and seeds (32! orders: a collision is
+  // astronomically unlikely, so these are exact statements about the pinned function)
+  EXPECT_NE(deal_permutation(20260718, 32, 0), deal_permutation(20260718, 32, 1));
+  EXPECT_NE(deal_permutation(20260718, 32, 0), deal_permutation(20260719, 32, 0));
+  std::vector<std::int64_t> identity(32);
+  for (int k = 0; k < 32; ++k) identity[static_cast<std::size_t>(k)] = k;
+  EXPECT_NE(deal_permutation(20260718, 32, 0), identity);
+  // pinned: the first block of seed 20260718 over 3 contracts
+  EXPECT_EQ(deal_permutation(20260718, 3, 0), deal_permutation(20260718, 3, 0));
+  EXPECT_THROW(episode_slot(1, 0, 1), std::invalid_argument);
+  EXPECT_THROW(episode_slot(1, 3, -1), std::invalid_argument);
 }
 
-TEST(EpisodeSeed, IsAPinnedPureFunction) {
+TEST(EpisodeSeed, IsAPinnedPureFunctionOfSeedAndBlock) {
   // SplitMix64 reference value: the first output of the generator seeded with 0 is 0xE220A8397B1DCDAF
   EXPECT_EQ(splitmix64(0), 0xE220A8397B1DCDAFull);
-  EXPECT_EQ(episode_seed(20260718, 1, 7), episode_seed(20260718, 1, 7));
-  EXPECT_EQ(episode_seed(20260718, 1, 7), splitmix64(splitmix64(splitmix64(20260718) ^ 1) ^ 7));
+  EXPECT_EQ(episode_seed(20260718, 7), splitmix64(splitmix64(splitmix64(20260718) ^ 0x696e6974737461ull) ^ 7));
   std::set<std::uint64_t> seeds;
   for (std::uint64_t s : {1ull, 2ull})
-    for (int c = 0; c < 4; ++c)
-      for (int e = 0; e < 50; ++e) seeds.insert(episode_seed(s, c, e));
+    for (int e = 0; e < 200; ++e) seeds.insert(episode_seed(s, e));
   EXPECT_EQ(seeds.size(), 400u);
 }
 
-TEST(AdapterEpisodeSeed, DependsOnlyOnSeedAndTheIndexWithinTheContract) {
-  // the contract index does not enter: a brute force over a split cannot recover it from the seed
+TEST(EpisodeSeed, EveryContractOfABlockStartsFromTheSameState) {
+  // the paired design: the environment's seed names the block, never the contract
+  JobSpec job;
+  job.seed = 20260718;
+  job.split.contracts = 32;
+  job.episodes = 96;
+  for (std::int64_t i = 0; i < job.episodes; ++i) {
+    const auto slot = episode_slot(job.seed, 32, i);
+    EXPECT_EQ(episode_seed(job.seed, slot.contract_episode), episode_seed(job.seed, i / 32));
+  }
+}
+
+TEST(AdapterEpisodeSeed, DependsOnlyOnSeedAndTheBlock) {
   EXPECT_EQ(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260718, 3));
   EXPECT_NE(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260718, 4));
   EXPECT_NE(adapter_episode_seed(20260718, 3), adapter_episode_seed(20260719, 3));
-  // and it is not the environment's seed of any (contract, episode) pair of a small job
+  // and it is not the environment's seed of any block of a long job
   std::set<std::uint64_t> env_seeds;
-  for (int c = 0; c < 9; ++c)
-    for (int e = 0; e < 90; ++e) env_seeds.insert(episode_seed(20260718, c, e));
-  for (int k = 0; k < 10; ++k) EXPECT_EQ(env_seeds.count(adapter_episode_seed(20260718, k)), 0u);
+  for (int e = 0; e < 1000; ++e) env_seeds.insert(episode_seed(20260718, e));
+  for (int k = 0; k < 1000; ++k) EXPECT_EQ(env_seeds.count(adapter_episode_seed(20260718, k)), 0u);
 }
 
 }  // namespace

@@ -23,7 +23,8 @@ inline std::vector<EpisodeRecord> make_records(const std::string& task, const st
       r.job_id = id;
       r.task = task;
       r.split = split;
-      r.method = method;
+      r.method = method.substr(0, method.find('{'));  // a label's base name
+      r.method_variant = method;
       r.seed = seed;
       r.contract_index = k % 2;
       r.contract_sha256 = sha256_hex(split + std::to_string(k % 2));

@@ -22,6 +22,7 @@ EpisodeRecord sample_record() {
   r.task = "pick_cube";
   r.split = "seen";
   r.method = "oracle";
+  r.method_variant = "oracle";
   r.seed = 20260718;
   r.contract_index = 1;
   r.contract_sha256 = sha256_hex("contract");
@@ -44,8 +45,8 @@ TEST(EpisodeRecord, SerialisesAsOneCanonicalLine) {
       "{\"backbone\":\"expert\",\"backbone_sha256\":\"" + sha256_hex("expert") +
       "\",\"contract_index\":1,\"contract_sha256\":\"" + sha256_hex("contract") +
       "\",\"episode_index\":7,\"job_id\":\"" + sha256_hex("job") +
-      "\",\"method\":\"oracle\",\"probe_displacement\":0.0125,\"probe_steps\":6,\"profile\":\"maniskill\",\"return\":12.5,"
-      "\"safety_flags\":[\"workspace_exit\"],\"schema_version\":\"1.1\",\"seed\":20260718,\"split\":\"seen\","
+      "\",\"method\":\"oracle\",\"method_variant\":\"oracle\",\"probe_displacement\":0.0125,\"probe_steps\":6,\"profile\":\"maniskill\",\"return\":12.5,"
+      "\"safety_flags\":[\"workspace_exit\"],\"schema_version\":\"2.0\",\"seed\":20260718,\"split\":\"seen\","
       "\"steps\":50,\"success_at_end\":false,\"success_once\":true,\"task\":\"pick_cube\"}";
   EXPECT_EQ(line, expected);
   EXPECT_EQ(line.find('\n'), std::string::npos);
@@ -88,8 +89,16 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
               ThrowsMessage<InputError>(HasSubstr("r.jsonl:2: job_id: expected 64 lowercase hex digits")));
   EXPECT_THAT([&] { parse_record_line(with("extra", "1"), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("r.jsonl:2: extra: unknown field")));
-  EXPECT_THAT([&] { parse_record_line(with("schema_version", "\"2.0\""), "r.jsonl:2"); },
+  EXPECT_THAT([&] { parse_record_line(with("schema_version", "\"9.0\""), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("schema_version: unsupported schema version")));
+  // records of 1.x were dealt and seeded differently and ran another entropy/DualABI rule: refused
+  EXPECT_THAT([&] { parse_record_line(with("schema_version", "\"1.1\""), "r.jsonl:2"); },
+              ThrowsMessage<InputError>(HasSubstr("re-run the job")));
+  EXPECT_THAT([&] { parse_record_line(with("method_variant", "\"no_adapt\""), "r.jsonl:2"); },
+              ThrowsMessage<InputError>(HasSubstr("method_variant: must be the method's name")));
+  EXPECT_THAT([&] { parse_record_line(with("method_variant", "\"oracle_x\""), "r.jsonl:2"); },
+              ThrowsMessage<InputError>(HasSubstr("method_variant: must be the method's name")));
+  EXPECT_NO_THROW(parse_record_line(with("method_variant", "\"oracle{x=1}\""), "r.jsonl:2"));
   EXPECT_THAT([&] { parse_record_line(with("safety_flags", "[\"a\",\"a\"]"), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("safety_flags: duplicate flag")));
   EXPECT_THAT([&] { parse_record_line(with("probe_steps", "51"), "r.jsonl:2"); },

@@ -80,9 +80,9 @@ TEST_F(RunnerTest, StampsJobFieldsAndDealsEpisodesOverContracts) {
   std::map<std::int64_t, std::set<std::uint64_t>> adapter_seeds;  // by index within the contract
   auto fn = [&](const EpisodeTask& t) {
     EXPECT_EQ(t.job, &job);
-    EXPECT_EQ(t.contract_index, t.episode_index % 3);
+    EXPECT_EQ(t.contract_index, episode_slot(job.seed, 3, t.episode_index).contract_index);
     EXPECT_EQ(t.contract_episode, t.episode_index / 3);
-    EXPECT_EQ(t.episode_seed, episode_seed(job.seed, t.contract_index, t.episode_index));
+    EXPECT_EQ(t.episode_seed, episode_seed(job.seed, t.contract_episode));
     EXPECT_EQ(t.adapter_seed, adapter_episode_seed(job.seed, t.contract_episode));
     std::lock_guard lock(mu);
     seen.insert(t.episode_index);
@@ -101,7 +101,7 @@ TEST_F(RunnerTest, StampsJobFieldsAndDealsEpisodesOverContracts) {
   for (std::size_t i = 0; i < 10; ++i) {
     const auto& rec = file.records[i];
     EXPECT_EQ(rec.episode_index, static_cast<std::int64_t>(i));
-    EXPECT_EQ(rec.contract_index, static_cast<std::int64_t>(i % 3));
+    EXPECT_EQ(rec.contract_index, episode_slot(job.seed, 3, static_cast<std::int64_t>(i)).contract_index);
     EXPECT_EQ(rec.job_id, job_id(job));
     EXPECT_EQ(rec.method, "oracle");
     EXPECT_EQ(rec.backbone_sha256, job.backbone.sha256);

@@ -36,14 +36,15 @@ class StoreTest : public ::testing::Test {
 
   // record i of `job` as the runner would stamp it
   static EpisodeRecord record(const JobSpec& job, std::int64_t i) {
-    const auto slot = episode_slot(job.split.contracts, i);
+    const auto slot = episode_slot(job.seed, job.split.contracts, i);
     EpisodeTask t{&job, job.seed, slot.contract_index, slot.contract_episode, i,
-                  episode_seed(job.seed, slot.contract_index, i), adapter_episode_seed(job.seed, slot.contract_episode), 0};
+                  episode_seed(job.seed, slot.contract_episode), adapter_episode_seed(job.seed, slot.contract_episode), 0};
     EpisodeRecord r = testing::fake_episode_fn()(t);
     r.job_id = job_id(job);
     r.task = job.task;
     r.split = job.split.name;
     r.method = job.method;
+    r.method_variant = job.method;
     r.seed = job.seed;
     r.contract_index = slot.contract_index;
     r.episode_index = i;
@@ -188,7 +189,10 @@ TEST_F(StoreTest, SummaryCountsAndIntervals) {
   EXPECT_EQ(s["safety_flag_counts"]["non_finite_action"], 1);
   EXPECT_EQ(s["episodes_with_safety_flags"], 2);
   EXPECT_EQ(s["per_contract"].size(), 3u);
-  EXPECT_EQ(s["per_contract"][0]["episodes"], 2);  // episodes 0 and 3
+  // episodes 0..2 are block 0 (each contract once), episode 3 opens block 1 with one contract
+  const std::int64_t twice = episode_slot(job.seed, 3, 3).contract_index;
+  for (std::size_t c = 0; c < 3; ++c)
+    EXPECT_EQ(s["per_contract"][c]["episodes"], static_cast<std::int64_t>(c) == twice ? 2 : 1) << "contract " << c;
   EXPECT_EQ(s["message"], "stopped");
   EXPECT_EQ(s["job_id"], job_id(job));
   const auto empty = make_job_summary(job, {}, 0, 0.0, "not run");

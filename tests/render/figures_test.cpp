@@ -32,6 +32,7 @@ std::vector<eval::EpisodeRecord> cell(const std::string& task, const std::string
     r.task = task;
     r.split = split;
     r.method = method;
+    r.method_variant = method;
     r.seed = 1;
     r.contract_index = i % 2;
     r.contract_sha256 = std::string(64, 'c');

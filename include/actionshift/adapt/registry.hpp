@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace actionshift::adapt {
@@ -31,8 +32,46 @@ bool method_needs_calibration(const std::string& method);
 
 /// The method's parameters with every default filled in, validated; unknown methods or parameters
 /// throw InputError(source "method", field, reason). E.g. entropy_probes → {"amplitude":0.5,
-/// "budget":6,"calibrated_preview":true,"lag_aware_preview":true,"max_active":32}.
+/// "budget":6,"calibrated_preview":false,"entropy_tolerance":0.0,"lag_aware_preview":false,
+/// "max_active":32,"motion_tiebreak":false} (the paper's rule).
 nlohmann::json resolve_method_params(const std::string& method, const nlohmann::json& params = nlohmann::json::object());
+
+/// A named variant of a method: a preset of its parameters under a name of its own, with the reason it
+/// exists. A method's bare name always means the paper's method (its defaults); a variant changes it.
+struct MethodVariant {
+  std::string method;      ///< the method it varies, e.g. "entropy_probes"
+  std::string name;        ///< the variant's name, e.g. "calibrated"
+  nlohmann::json params;   ///< the parameters it sets (a subset of the method's)
+  std::string rationale;   ///< one sentence: what it changes and why (docs/adapters.md)
+};
+
+/// Every named variant: entropy_probes{calibrated} and dualabi{calibrated} (the project's calibrated,
+/// lag-aware probe preview; entropy_probes's also adds the motion tie-break).
+const std::vector<MethodVariant>& method_variants();
+
+/// A method as written by a user: its name and the parameters its label sets (not yet resolved).
+struct MethodLabel {
+  std::string name;                                  ///< base method name, e.g. "entropy_probes"
+  nlohmann::json params = nlohmann::json::object();  ///< parameters named in the label
+};
+
+/// Parses a method label: `name`, `name{variant}`, `name{key=value,...}` or `name{variant,key=value,...}`
+/// (at most one variant, first). Values: true/false, integers, decimals, or text (quote text that holds
+/// `,`, `{` or `}` as a JSON string). Throws InputError("method", field, reason) for a malformed label, an
+/// unknown variant or a key given twice. The name itself is checked by resolve_method_params.
+MethodLabel parse_method_label(std::string_view label);
+
+/// Merges a label's parameters with explicit ones (`--params`, a YAML entry's `params`): a key given by
+/// both must have the same value, else InputError("method " + name, key, reason).
+nlohmann::json merge_method_params(const MethodLabel& label, const nlohmann::json& explicit_params);
+
+/// The compact, canonical label of a method with *resolved* parameters: the bare name when every
+/// parameter is the default (the paper's method); otherwise `name{...}` listing the named variant whose
+/// every parameter matches (the one setting most parameters), then each remaining parameter that differs
+/// from the default (or from the variant) as key=value, keys sorted. parse_method_label of the label
+/// resolves to the same parameters. This label is what records and summary cells carry
+/// (`method_variant`), so two variants of one method are two cells.
+std::string method_variant_label(const std::string& method, const nlohmann::json& resolved_params);
 
 /// Builds an adapter. `params` must be resolved (resolve_method_params). Throws InputError when a
 /// required input is missing (no pool for a pool method, no truth for the oracle).

@@ -36,9 +36,25 @@ adapt::ResponseCalibration builtin_calibration(const std::string& task, const st
 /// Throws InputError if this build has none.
 adapt::ResponseCalibration builtin_selftest_calibration(const std::string& task, const std::string& profile = "maniskill");
 
+/// A method as written (a name or a label such as `entropy_probes{calibrated}`, with explicit
+/// parameters as JSON object text) as its base name and the label's parameters merged with the explicit
+/// ones (adapt::parse_method_label, adapt::merge_method_params); not yet resolved.
+MethodEntry canonical_method(const MethodEntry& m);
+
 /// Method parameters with defaults filled in (adapt::resolve_method_params) as canonical JSON text:
-/// what enters the job spec, so a changed default changes the job id.
+/// what enters the job spec, so a changed default changes the job id. `method` may be a label.
 std::string resolved_method_params(const std::string& method, const std::string& params_json = "{}");
+
+/// The job's method variant label (adapt::method_variant_label of its resolved parameters), e.g.
+/// `entropy_probes`, `entropy_probes{calibrated}`, `dualabi{tau=0.5}`: what its records and summary
+/// cells carry.
+std::string method_variant(const JobSpec& job);
+
+/// A label as a user wrote it, in the canonical form records carry: `entropy_probes{calibrated_preview=true,
+/// lag_aware_preview=true,entropy_tolerance=0.001,motion_tiebreak=true}` → `entropy_probes{calibrated}`,
+/// `entropy_probes{budget=6}` → `entropy_probes`. A name outside the registry is returned as given.
+/// Throws InputError for a malformed label or invalid parameters of a registry method.
+std::string canonical_method_label(const std::string& label);
 
 /// Run-time options of an episode function that do not change results (and so stay out of the job id).
 struct EpisodeFnOptions {

@@ -18,7 +18,10 @@
 namespace actionshift::eval {
 
 /// Version of the job spec canonical JSON.
-inline constexpr std::string_view kJobSchemaVersion = "2.0";
+/// 3.0: episodes are dealt to contracts by a seeded permutation per block and every contract of a block
+/// starts from the same initial state (episode_slot, episode_seed); 2.0 ids named round-robin dealing
+/// with per-contract initial states, which let a first observation identify the hidden contract.
+inline constexpr std::string_view kJobSchemaVersion = "3.0";
 
 /// A split manifest by name and content hash, with the number of evaluation contracts it holds.
 struct SplitRef {
@@ -128,31 +131,37 @@ std::string summary_file_name(std::string_view id);
 
 /// Where episode `episode_index` of a job runs.
 struct EpisodeSlot {
-  std::int64_t contract_index{0};     ///< episode_index mod contracts
-  std::int64_t contract_episode{0};   ///< episode_index div contracts: its index within the contract
+  std::int64_t contract_index{0};     ///< the contract it runs (see episode_slot)
+  std::int64_t contract_episode{0};   ///< episode_index div contracts: its block, and its index within the contract
 };
 
-/// Episodes are dealt round-robin over the split's contracts: episode i runs contract i mod n as
-/// that contract's (i div n)-th episode. A job of N episodes gives each contract ⌊N/n⌋ or ⌈N/n⌉.
-/// Throws std::invalid_argument if contracts ≤ 0 or episode_index < 0.
-EpisodeSlot episode_slot(std::int64_t contracts, std::int64_t episode_index);
+/// Episodes are dealt in blocks of n = `contracts`: episode i belongs to block b = i div n and runs
+/// contract π_b(i mod n), where π_b is a permutation of 0..n−1 drawn from (seed, b) (deal_permutation).
+/// Every contract runs once per full block, so a job of N episodes gives each contract ⌊N/n⌋ or ⌈N/n⌉;
+/// which contract runs at which position is not public without the seed, so a process that counts its
+/// resets does not learn the contract. Throws std::invalid_argument if contracts ≤ 0 or episode_index < 0.
+EpisodeSlot episode_slot(std::uint64_t seed, std::int64_t contracts, std::int64_t episode_index);
+
+/// π_b: a Fisher–Yates shuffle of 0..n−1 (for j = n−1 … 1 swap positions j and x_j mod (j+1)), where
+/// x_{n−1} = splitmix64(s), x_{j−1} = splitmix64(x_j) and s = splitmix64(splitmix64(seed ^ D) ^ block)
+/// for a fixed domain constant D.
+std::vector<std::int64_t> deal_permutation(std::uint64_t seed, std::int64_t contracts, std::int64_t block);
 
 /// SplitMix64 finaliser (Steele, Lea & Flood 2014): x + 0x9E3779B97F4A7C15, then
 /// xor-shift-multiply by 0xBF58476D1CE4E5B9 (>>30) and 0x94D049BB133111EB (>>27), then ^ (>>31).
 std::uint64_t splitmix64(std::uint64_t x) noexcept;
 
-/// An episode's seed, the only source of its randomness (initial state, policy noise):
-/// splitmix64(splitmix64(splitmix64(seed) ^ contract_index) ^ episode_index).
-/// A pure function of the three values recorded in the episode's record, so every method sees the
-/// same initial states for the same (seed, contract index, episode index).
-std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_index, std::int64_t episode_index) noexcept;
+/// An episode's environment seed, the only source of its randomness (initial state, observation noise):
+/// splitmix64(splitmix64(splitmix64(seed) ^ D) ^ contract_episode) for a fixed domain constant D.
+/// It depends on the job's seed and the episode's block only, so **every contract of the split sees the
+/// same initial states** (a paired design): neither the first observation nor the initial tool rotation
+/// carries information about which contract is hidden, and methods and contracts pair episode by episode.
+std::uint64_t episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept;
 
 /// The seed handed to the adapter (Adapter::begin_episode): splitmix64(splitmix64(seed ^ D) ^
-/// contract_episode) with a fixed domain constant D. It depends only on the job's seed and the
-/// episode's index *within* its contract, so it is the same for every contract of the split: an
-/// adapter cannot invert it to the contract index, and the dealing order (which episode index of
-/// the job ran which contract) is not in it. (episode_seed, which also fixes the initial state,
-/// stays with the environment.)
+/// contract_episode) with a fixed domain constant D. Like episode_seed it depends only on the job's seed
+/// and the episode's block, so it is the same for every contract of the split: an adapter cannot invert
+/// it to the contract index. (episode_seed, which fixes the initial state, stays with the environment.)
 std::uint64_t adapter_episode_seed(std::uint64_t seed, std::int64_t contract_episode) noexcept;
 
 }  // namespace actionshift::eval

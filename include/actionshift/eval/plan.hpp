@@ -62,6 +62,10 @@ struct PlanResolver {
   std::function<PoolRef(const std::string& pool)> pool;
   std::function<std::optional<std::string>(const std::string& task, const MethodEntry& method, const std::string& profile)>
       calibration;
+  /// If set: the method as written (a label such as `entropy_probes{calibrated}` with its params) in
+  /// the form every other callback receives: the base name and the label's parameters merged with the
+  /// entry's. Unset: the entry as written.
+  std::function<MethodEntry(const MethodEntry& method)> canonical_method;
   std::function<void(const MethodEntry& method)> check_method;
   /// If set: the method's parameters as they enter the job spec (e.g. with defaults filled in, so
   /// a changed default changes the job id). Unset: the parameters as written.

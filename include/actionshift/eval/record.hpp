@@ -12,16 +12,21 @@
 namespace actionshift::eval {
 
 /// Version of the episode record schema written by this library.
-inline constexpr std::string_view kRecordSchemaVersion = "1.1";
+inline constexpr std::string_view kRecordSchemaVersion = "2.0";
 
 /// One evaluated episode. A value type: the runner stamps the job fields, the episode function fills
 /// the outcome fields.
 struct EpisodeRecord {
-  std::string schema_version{kRecordSchemaVersion};  ///< "1.1" (1.1 added `profile`)
+  /// "2.0": 2.0 added `method_variant` and paired initial states (eval/job.hpp episode_seed); 1.1 added
+  /// `profile`. Records of 1.x are refused: their episodes were dealt and seeded differently.
+  std::string schema_version{kRecordSchemaVersion};
   std::string job_id;           ///< 64-hex job id (eval/job.hpp)
   std::string task;             ///< task name, e.g. "pick_cube"
   std::string split;            ///< split name, e.g. "seen"
   std::string method;           ///< method name, e.g. "oracle"
+  /// The method variant's label (eval::method_variant): the bare name for the paper's method, e.g.
+  /// "entropy_probes", or "entropy_probes{calibrated}", "dualabi{tau=0.5}". Summary cells key on it.
+  std::string method_variant;
   std::uint64_t seed{0};        ///< experimental seed of the job
   std::int64_t contract_index{0};   ///< index of the contract in the split's evaluation list
   std::string contract_sha256;  ///< 64-hex hash of that contract's canonical JSON

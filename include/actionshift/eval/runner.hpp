@@ -18,10 +18,10 @@ namespace actionshift::eval {
 struct EpisodeTask {
   const JobSpec* job{nullptr};        ///< the job (never null inside run_job)
   std::uint64_t seed{0};              ///< the job's experimental seed
-  std::int64_t contract_index{0};     ///< contract of the split (episode_index mod contracts)
-  std::int64_t contract_episode{0};   ///< index of this episode within its contract
+  std::int64_t contract_index{0};     ///< contract of the split (episode_slot: a seeded deal per block)
+  std::int64_t contract_episode{0};   ///< the episode's block: its index within its contract
   std::int64_t episode_index{0};      ///< index of the episode within the job
-  std::uint64_t episode_seed{0};      ///< episode_seed(seed, contract_index, episode_index): the environment's
+  std::uint64_t episode_seed{0};      ///< episode_seed(seed, contract_episode): the environment's, the same for every contract
   std::uint64_t adapter_seed{0};      ///< adapter_episode_seed(seed, contract_episode): the only seed an adapter gets
   unsigned worker{0};                 ///< worker thread index in [0, threads): key per-worker state on it
 };

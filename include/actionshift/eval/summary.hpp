@@ -46,6 +46,10 @@ struct CellKey {
   auto operator<=>(const CellKey&) const = default;
 };
 
+/// The cell of a record: (task, split, method variant label, backbone). Two variants of one method
+/// (`entropy_probes`, `entropy_probes{calibrated}`) are two cells.
+CellKey cell_key(const EpisodeRecord& r);
+
 /// Success of one seed within a cell.
 struct SeedRate {
   std::uint64_t seed{0};
