@@ -1,216 +1,131 @@
 #!/usr/bin/env python3
-"""Writes docs/results/learned_backbone.md (scripts/learned_backbone): Gate 1 and the tournament's reference
-cells with the imitation MLP as a second backbone column beside the scripted expert, and the paper's
-frozen-PPO numbers beside both. Reads `actionshift summarize DIR --json`, `actionshift gate1 --json` and the
-promotion verdicts `actionshift gate promote` wrote. Standard library only.
-usage: scripts/learned_backbone_report.py OUT_DIR EXPERT_GATE1_DIR EXPERT_TOURNAMENT_DIR ACTIONSHIFT_BINARY WALL_SECONDS [LEARNED]
-(LEARNED: the learned backbone, mlp (default) or ppo; its experiments are gate1_LEARNED.yaml and tournament_LEARNED.yaml)"""
-import glob
+"""Writes docs/results/learned_backbone.md (LEARNED=mlp) and docs/results/learned_backbone_ppo.md (LEARNED=ppo)
+(scripts/learned_backbone): layout of two `actionshift compare` JSONs, Gate 1 (the expert's gate1 directory and
+the learned backbone's, pairs scripts/pages/gate1.pairs) and the tournament's reference cells (the expert's
+tournament directory and the learned backbone's, pairs scripts/pages/learned_backbone.pairs), the learned
+backbone's Gate-1 verdict file and its committed Gate-0 verdict files (configs/gates/gate0/). No statistics here.
+usage: scripts/learned_backbone_report.py --learned mlp|ppo --gate1-compare FILE --tournament-compare FILE
+       --gate1-verdict FILE --commit SHA --command TEXT [--wall S] [--cores N] [--gate0-dir DIR] [--numbers FILE]"""
+import argparse
 import json
 import os
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from paper_numbers import TABLE5  # noqa: E402
-from report_util import cpu_text  # noqa: E402
+from pages import fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
 
-out, expert_gate1, expert_tournament, binary, wall = sys.argv[1:6]
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LEARNED = sys.argv[6] if len(sys.argv) > 6 else "mlp"
-KIND = {"mlp": "imitation MLP", "ppo": "PPO"}.get(LEARNED, LEARNED)
-# a task without cells prints dashes; stack_cube has a PPO backbone (warm-started from its imitation
-# network) but no imitation backbone that passes Gate 0
-TASKS = ["pick_cube", "push_cube", "pull_cube"] + (["stack_cube"] if LEARNED == "ppo" else [])
-GATE1_SPLITS = ["seen", "unseen_composition", "long_lag"]
-REF_SPLITS = ["reference_seen", "reference_unseen_composition"]
-BELIEF = ["exact_belief", "fixed_probes", "random_probes", "entropy_probes", "dualabi"]
-METHODS = ["oracle"] + BELIEF + ["no_adapt"]
+ap = argparse.ArgumentParser()
+ap.add_argument("--learned", required=True, choices=["mlp", "ppo"])
+ap.add_argument("--gate1-compare", required=True)
+ap.add_argument("--tournament-compare", required=True)
+ap.add_argument("--gate1-verdict", required=True, help="`actionshift gate1` verdict file of the learned backbone's gate1 directory")
+ap.add_argument("--commit", required=True)
+ap.add_argument("--command", required=True)
+ap.add_argument("--wall")
+ap.add_argument("--cores")
+ap.add_argument("--gate0-dir", default=os.path.join("configs", "gates", "gate0"))
+ap.add_argument("--numbers", default=paper.NUMBERS)
+a = ap.parse_args()
 
+L = a.learned
+KIND = {"mlp": "imitation MLP", "ppo": "PPO"}[L]
+g = load_comparison(a.gate1_compare)
+t = load_comparison(a.tournament_compare)
+numbers = paper.load_numbers(a.numbers)
+with open(a.gate1_verdict) as f:
+    g1v = json.load(f)
+lg, lt = g.cells_where(backbone=L), t.cells_where(backbone=L)
+specs = provenance.job_specs(g.input_dirs() + t.input_dirs(), g.jobs(lg) + t.jobs(lt))
+backbones = ["expert", L]
 
-def gate0_rate(task):
-    path = os.path.join(ROOT, "configs/gates/gate0", f"{LEARNED}.{task}.json")
-    if not os.path.exists(path):
-        return None
-    return json.load(open(path))["cells"][f"{LEARNED}/{task}"]["competence"]["interval"]["rate"]
+out = [provenance.header(
+    f"The learned backbone: Gate 1 and the tournament's reference cells, expert and {KIND}",
+    "scripts/learned_backbone_report.py", a.command, a.commit, g.input_dirs() + t.input_dirs(),
+    provenance.spec_values(specs, "profile"), g.seeds(lg + lt), g.episodes(lg) + t.episodes(lt),
+    jobs=len(g.jobs(lg)) + len(t.jobs(lt)), episodes_per_seed=g.episodes_per_seed(lg + lt), wall=a.wall,
+    cores=a.cores, paper_source=t.paper_source(), bootstrap=t.bootstrap(),
+    extra=[f"The counts above are the `{L}` backbone's; the expert's cells come from the same experiments' expert "
+           f"directories. Experiments `configs/experiments/gate1_{L}.yaml` and `configs/experiments/tournament_{L}.yaml`.",
+           f"Learned backbone `{L}`, weight files by SHA-256 prefix: "
+           + ", ".join(sorted({s['backbone']['sha256'][:12] + f" ({s['task']})" for s in specs})) + ".",
+           "Both probe rules are run: bare `entropy_probes` / `dualabi` are the paper's rule, `{calibrated}` the "
+           "project's (docs/adapters.md); only the paper's rule gets the paper's numbers."])]
+out.append("Every other table of this benchmark uses the scripted expert as the frozen backbone; the paper's claims are "
+           f"about frozen *learned* policies. This page sets the {KIND} (docs/backbones.md) beside the expert on Gate 1 "
+           "and on the tournament's reference cells. The "
+           + ("imitation MLP's page is docs/results/learned_backbone.md.\n\n" if L == "ppo"
+              else "PPO backbones have their own page, docs/results/learned_backbone_ppo.md.\n\n"))
 
+# ---- Gate 0, from the committed verdict files
+out.append(f"## Gate 0 of the `{L}` backbones (from `{a.gate0_dir}`)\n\n")
+rows = []
+for task in sections.TASK_ORDER:
+    p = os.path.join(a.gate0_dir, f"{L}.{task}.json")
+    if not os.path.exists(p):
+        continue
+    with open(p) as f:
+        v = json.load(f)["cells"][f"{L}/{task}"]
+    rows.append([task, f"`{L}.{task}.json`", v["verdict"], v["decision"], fmt.rate(v["competence"]["interval"]),
+                 v["competence"]["rule"], v["reason"] or fmt.DASH])
+out.append(table.markdown(["task", "verdict file", "verdict", "decision", "competence [Wilson 95 %]", "rule", "reason"], rows)
+           if rows else f"No Gate-0 verdict file for `{L}` in `{a.gate0_dir}`.\n")
+excluded = [r[0] for r in rows if r[2] != "pass"]
+out.append("\n" + (f"Excluded at Gate 0 (no cells below): {', '.join(excluded)}.\n" if excluded
+                   else f"Every `{L}` backbone with a verdict file passes Gate 0.\n"))
 
-def gate0_note():
-    """A backbone below Gate 1's 0.95 oracle bar at Gate 0 cannot pass Gate 1: say so, from the verdict files."""
-    rates = {t: gate0_rate(t) for t in TASKS}
-    weak = {t: r for t, r in rates.items() if r is not None and r < 0.95}
-    if not weak:
-        return ""
-    strong = [r for t, r in rates.items() if r is not None and t not in weak]
-    return (" Below Gate 1's oracle bar of 0.95 already at Gate 0: " + ", ".join(f"{t} {r:.3f}" for t, r in weak.items()) +
-            (f" (the other tasks {min(strong):.3f}-{max(strong):.3f})" if strong else "") + "; the oracle restores only"
-            " what the backbone itself achieves, so those Gate 1 cells miss the bar by the backbone's competence, not by the"
-            " adapter's.")
+# ---- Gate 1
+out.append(f"\n## Gate 1 with both backbones\n\nVerdict for `{L}`: **Gate 1 {'passed' if g1v.get('passed') else 'not passed'}** "
+           f"(claim status `{g1v.get('claim_status')}`; gated cells need oracle >= 0.95 and no_adapt <= 0.05; long_lag is "
+           "descriptive). The paper's numbers are for its reference contracts (`reference_<split>`), set beside our "
+           "generated `<split>`.\n\n")
+rows = []
+for c in sections.ordered_cells(g, backbone=L):
+    if c["method"] != "oracle":
+        continue
+    task, split = c["task"], c["split"]
+    v = g1v.get("cells", {}).get(f"{task}/{split}", {})
+    rows.append([task, split, fmt.cell_rate(g.cell(task, split, "oracle", "expert")), fmt.cell_rate(c),
+                 paper.entry_value(numbers.find_cell("success_once", task, "reference_" + split, "oracle", L)),
+                 fmt.cell_rate(g.cell(task, split, "no_adapt", "expert")), fmt.cell_rate(g.cell(task, split, "no_adapt", L)),
+                 paper.entry_value(numbers.find_cell("success_once", task, "reference_" + split, "no_adapt", L)),
+                 fmt.cmp_diff(g.comparison("oracle", "no_adapt", task, split, L)), v.get("verdict", fmt.DASH),
+                 v.get("reason", fmt.DASH)])
+out.append(table.markdown(["task", "split", "oracle, expert", f"oracle, {L}", "paper oracle", "no_adapt, expert",
+                           f"no_adapt, {L}", "paper no_adapt", f"oracle − no_adapt, {L} [95 %]", f"{L} verdict",
+                           "reason"], rows))
 
+# ---- headline and findings
+out.append("\n## Entropy − fixed probes on pick_cube / reference_seen\n\n")
+out.append(sections.headline_table(t, backbones))
+out.append("\n## The paper's findings, tested on both backbones\n\n" + sections.STATUS_RULE + "\n\n")
+out.append(sections.findings_table(t, numbers, backbones))
 
-def run_json(*args):
-    return json.loads(subprocess.run([binary, *args], check=True, capture_output=True, text=True).stdout)
-
-
-def cells(results, backbone):
-    """(task, split, method) -> summarize cell, for one backbone of a results directory."""
-    return {(c["task"], c["split"], c["method"]): c for c in run_json("summarize", results, "--json")["cells"]
-            if c["backbone"] == backbone}
-
-
-def specs(results, cs):
-    jobs = sorted({j for c in cs.values() for j in c["jobs"]})
-    return [json.load(open(os.path.join(results, j + ".summary.json")))["job"] for j in jobs]
-
-
-g_mlp_dir, t_mlp_dir = os.path.join(out, f"gate1_{LEARNED}"), os.path.join(out, f"tournament_{LEARNED}")
-g_exp, g_mlp = cells(expert_gate1, "expert"), cells(g_mlp_dir, LEARNED)
-t_exp, t_mlp = cells(expert_tournament, "expert"), cells(t_mlp_dir, LEARNED)
-gate1 = json.loads(subprocess.run([binary, "gate1", "--results", g_mlp_dir, "--json"], capture_output=True, text=True).stdout)
-mlp_specs = specs(g_mlp_dir, g_mlp) + specs(t_mlp_dir, t_mlp)
-sha = sorted({s["backbone"]["sha256"][:12] + f" ({s['task']})" for s in mlp_specs})
-profiles = sorted({s.get("profile", "?") for s in mlp_specs})
-seeds = sorted({s["seed"] for s in mlp_specs})
-episodes = sum(c["episodes"] for c in list(g_mlp.values()) + list(t_mlp.values()))
-promos = {}
-for path in glob.glob(os.path.join(t_mlp_dir, "promotion.*.json")):
-    v = json.load(open(path))
-    promos[(v["candidate"], v["baseline"])] = v
-commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-times_file = os.path.join(out, ".times")
-cpu = cpu_text(open(times_file).read().splitlines()[-1]) if os.path.exists(times_file) else ""
-
-
-def w(c):
-    if not c:
-        return "—"
-    s = c["success_once"]
-    return f"{s['rate']:.3f} [{s['lower']:.3f}, {s['upper']:.3f}]"
-
-
-def rate(c):
-    return None if not c else c["success_once"]["rate"]
-
-
-def f3(x):
-    return "—" if x is None else f"{x:.3f}"
-
-
-print(f"# The learned backbone: Gate 1 and the tournament's reference cells, expert and {KIND}\n")
-print(f"Generated by `scripts/learned_backbone_report.py` from `{out}` (learned) and `{expert_gate1}`, `{expert_tournament}`"
-      f" (expert) at commit `{commit}` (do not edit by hand).\n")
-print("Every other table of this benchmark uses the scripted expert as the frozen backbone; the paper's claims are about")
-if LEARNED == "ppo":
-    print("frozen *learned* policies, PPO among them. This page re-runs Gate 1 and the tournament's reference cells with")
-    print("the PPO backbones trained here (`train ppo`, docs/backbones.md; Gate 0 in docs/results/gate0.md), the paper's")
-    print("own kind of backbone, and sets them beside the expert's cells of the same experiments. The imitation MLP's")
-    missing = [t for t in TASKS if not any(k[0] == t for k in list(g_mlp) + list(t_mlp))]
-    print("page is docs/results/learned_backbone.md." + (f" {', '.join(missing)} has no cells (its rows are dashes): no PPO"
-          " backbone of it passes Gate 0 within this release's training budget (docs/backbones.md)." if missing else "") +
-          gate0_note() + "\n")
-else:
-    print("frozen *learned* policies. This page re-runs Gate 1 and the tournament's reference cells with the imitation")
-    print("backbone that passes Gate 0 on the tasks (the DAgger-trained MLP, docs/backbones.md) and sets it beside the")
-    print("expert's cells of the same experiments (the PPO backbones have their own page, docs/results/learned_backbone_ppo.md).")
-    print("stack_cube is left out: its MLP is excluded at Gate 0.\n")
-THREADS = os.environ.get("THREADS", "0")
-print(f"- Command: `{'THREADS=' + THREADS + ' ' if THREADS != '0' else ''}{'LEARNED=' + LEARNED + ' ' if LEARNED != 'mlp' else ''}scripts/learned_backbone {out} {expert_gate1} {expert_tournament}`;"
-      f" experiments `configs/experiments/gate1_{LEARNED}.yaml`"
-      f" and `configs/experiments/tournament_{LEARNED}.yaml` (the expert cells come from `gate1.yaml` and `tournament.yaml`);"
-      f" {len({j for c in list(g_mlp.values()) + list(t_mlp.values()) for j in c['jobs']})} learned-backbone jobs, {episodes:,} episodes;"
-      f" wall time {int(float(wall))} s on {os.cpu_count()} cores" + (f" (`run --threads {THREADS}`)" if THREADS != "0" else "") + f"{cpu}.")
-per_job = lambda d, cs: "/".join(str(e) for e in sorted({s["episodes"] for s in specs(d, cs)}))
-print(f"- Simulator profile **{', '.join(profiles)}**; seeds {', '.join(map(str, seeds))}; Gate 1: {per_job(g_mlp_dir, g_mlp)} episodes"
-      f" per job on the generated splits (32 contracts each); tournament: {per_job(t_mlp_dir, t_mlp)} episodes per job (half per"
-      " contract) on the paper's frozen splits with its nine-contract pool `reference9`; live tool-frame rotation.")
-print(f"- Learned backbone `{LEARNED}`, weight files by SHA-256 prefix: {', '.join(sha)}.")
-print("- Success is success_once with its Wilson 95 % interval pooled over the seeds; paired differences are"
-      " `actionshift gate promote` (paired bootstrap over (seed, contract, episode), 10,000 resamples).")
-print("- Paper columns: the paper's Table 2 (Gate 1) and Table 5 (tournament), frozen PPO on ManiSkill, on the reference's"
-      " representative contracts.\n")
-
-print("## Gate 1 with both backbones\n")
-print(f"Verdict for `{LEARNED}`: **Gate 1 {'passed' if gate1.get('passed') else 'not passed'}** (claim status"
-      f" `{gate1.get('claim_status', '?')}`; gated cells need oracle ≥ 0.95 and no_adapt ≤ 0.05; long_lag is descriptive).\n")
-print(f"| task | split | oracle, expert | oracle, {LEARNED} | paper oracle | no_adapt, expert | no_adapt, {LEARNED} | paper no_adapt | {LEARNED} verdict |")
-print("|---|---|---|---|---:|---|---|---:|---|")
-for t in TASKS:
-    for s in GATE1_SPLITS:
-        p = TABLE5.get((t, "reference_" + s, "oracle"), (None,))[0], TABLE5.get((t, "reference_" + s, "no_adapt"), (None,))[0]
-        v = gate1.get("cells", {}).get(f"{t}/{s}", {})
-        print(f"| {t} | {s} | {w(g_exp.get((t, s, 'oracle')))} | {w(g_mlp.get((t, s, 'oracle')))} | {f3(p[0])} | "
-              f"{w(g_exp.get((t, s, 'no_adapt')))} | {w(g_mlp.get((t, s, 'no_adapt')))} | {f3(p[1])} | {v.get('verdict', '—')} |")
-
-print("\n## The tournament's reference cells with both backbones\n")
-for t in TASKS:
-    for s in REF_SPLITS:
-        print(f"### {t} / {s}\n")
-        print(f"| method | expert | {LEARNED} | {LEARNED} probe steps | paper (frozen PPO) |")
-        print("|---|---|---|---:|---:|")
-        for m in METHODS:
-            cm = t_mlp.get((t, s, m))
-            p = TABLE5.get((t, s, m))
-            print(f"| {m} | {w(t_exp.get((t, s, m)))} | {w(cm)} | {'—' if not cm else '%.2f' % cm['mean_probe_steps']} | {f3(p[0] if p else None)} |")
-        print()
-
-print("## Does the learned backbone separate the belief methods?\n")
-print("Belief-family spread = max − min success over the five pool-belief methods; oracle − worst = the oracle's success")
-print("minus the worst belief method's. The paper's Pick/seen spread is 0.062 (entropy 0.987 vs random 0.925).\n")
-print(f"| task | split | spread, expert | spread, {LEARNED} | oracle − worst, expert | oracle − worst, {LEARNED} | paper spread |")
-print("|---|---|---:|---:|---:|---:|---:|")
-reading = []
-for t in TASKS:
-    for s in REF_SPLITS:
-        row = []
-        for cs in (t_exp, t_mlp):
-            r = [rate(cs.get((t, s, m))) for m in BELIEF]
-            r = [x for x in r if x is not None]
-            o = rate(cs.get((t, s, "oracle")))
-            row.append((max(r) - min(r) if r else None, o - min(r) if r and o is not None else None))
-        pr = [TABLE5[(t, s, m)][0] for m in BELIEF if (t, s, m) in TABLE5]
-        print(f"| {t} | {s} | {f3(row[0][0])} | {f3(row[1][0])} | {f3(row[0][1])} | {f3(row[1][1])} | {f3(max(pr) - min(pr) if pr else None)} |")
-print("\nPaired differences on the learned backbone (`gate promote`; an interval that excludes 0 separates the pair):\n")
-print("| task | split | pair | difference (95 %) | verdict |")
-print("|---|---|---|---|---|")
-separated = []
-for (cand, base), v in sorted(promos.items()):
-    for key in sorted(v["cells"]):
-        c = v["cells"][key]
-        if c["split"] not in REF_SPLITS:
+# ---- cells
+out.append("\n## The reference cells, both backbones\n\nPer-seed rates in ascending seed order (the paper's Table 5 "
+           "prints per-seed rates too; they sit in the paper-numbers file's entries).\n\n")
+learned_splits = set(t.values("split", lt))
+for task in sections.tasks(t, lt):
+    for split in sections.splits(t, lt):
+        cs = [c for c in sections.ordered_cells(t, task=task, split=split) if c["backbone"] in backbones]
+        if not any(c["backbone"] == L for c in cs):
             continue
-        d = c["difference"]
-        excl = d["lower"] > 0 or d["upper"] < 0
-        if excl:
-            pc, pb = TABLE5.get((c["task"], c["split"], cand)), TABLE5.get((c["task"], c["split"], base))
-            paper = "" if not (pc and pb) else (f" (paper {pc[0] - pb[0]:+.3f}: "
-                                               f"{'the same sign' if (pc[0] - pb[0]) * d['estimate'] > 0 else 'a different sign'})")
-            separated.append(f"{c['task']}/{c['split']} {cand} − {base} {d['estimate']:+.3f} [{d['lower']:+.3f}, {d['upper']:+.3f}]{paper}")
-        print(f"| {c['task']} | {c['split']} | {cand} − {base} | {d['estimate']:+.3f} [{d['lower']:+.3f}, {d['upper']:+.3f}]"
-              f"{' **excludes 0**' if excl else ''} | {c['verdict']} |")
+        out.append(f"\n### {task} / {split}\n\n")
+        cs.sort(key=lambda c: (sections._key(sections.METHOD_ORDER, c["method"]), c["backbone"] != "expert"))
+        rows = []
+        for c in cs:
+            pe = paper.cell_entry(c)
+            rows.append([f"`{c['method']}`", c["backbone"], fmt.cell_rate(c), fmt.per_seed(c), paper.cell_column(c),
+                         " / ".join(fmt.num(s["rate"]) for s in pe["per_seed"]) if pe and pe.get("per_seed") else fmt.DASH,
+                         fmt.probe_steps(c), paper.cell_column(c, "mean_probe_steps"), fmt.displacement(c), fmt.safety(c)])
+        out.append(table.markdown(["method", "backbone", "success [Wilson 95 %]", "per seed", "paper",
+                                   "paper per seed", "probe steps", "paper probe steps", "displacement [m]",
+                                   "safety: flagged (flags)"], rows))
 
-print("\n## Reading\n")
-for t in TASKS:
-    for s in ("seen", "unseen_composition"):
-        o = rate(g_mlp.get((t, s, "oracle")))
-        if o is not None:
-            reading.append(f"{t}/{s} {o:.3f}")
-ex = [rate(g_exp.get((t, s, "oracle"))) for t in TASKS for s in ("seen", "unseen_composition")]
-ex = [x for x in ex if x is not None]
-print("- Gate 1 oracle with the learned backbone: " + ", ".join(reading) + " (the gate's bar is 0.95; the expert's"
-      f" cells are {min(ex):.3f}-{max(ex):.3f}). Where the {KIND}'s oracle is below the expert's, the gap is the backbone's own competence"
-      " (its Gate 0 in docs/results/gate0.md), not the adapter's.")
-if separated:
-    print("- Paired differences that exclude 0 on the learned backbone: " + "; ".join(separated) + ".")
-else:
-    print("- No paired difference between belief methods excludes 0 on the learned backbone: the tie the expert shows on"
-          " the reference cells is not an artefact of the scripted backbone's robustness alone.")
-lag = []
-for t in TASKS:
-    e, m = rate(g_exp.get((t, "long_lag", "oracle"))), rate(g_mlp.get((t, "long_lag", "oracle")))
-    p = TABLE5.get((t, "reference_long_lag", "oracle"))
-    if e is not None and m is not None:
-        lag.append(f"{t} expert {e:.3f}, {LEARNED} {m:.3f}" + (f" (paper {p[0]:.3f})" if p else ""))
-print("- On the long-lag split the backbones differ: the oracle re-encodes the contract but cannot undo"
-      " its 2-4 step delay, so the cell measures how well the backbone itself tolerates a delayed arm: " + "; ".join(lag) + ".")
-print("- A belief method cannot do better than the oracle with the same backbone except by chance; compare each method"
-      " with its own backbone's oracle row, not with the paper's, whose backbone (PPO on ManiSkill) is different.")
+# ---- promotion audit (the paper's Table 7 has its own promotion audit)
+out.append("\n## Promotion audit: every pair × cell\n\n" + sections.PROMOTION_RULES + "\n\n")
+out.append(sections.promotion_table(t, [x for x in t.comparisons if x["backbone"] in backbones and x["split"] in learned_splits]))
+notes = g.notes() + t.notes()
+if notes:
+    out.append("\nNotes from `compare`: " + "; ".join(notes) + "\n")
+sys.stdout.write("".join(out))

@@ -1,344 +1,123 @@
 #!/usr/bin/env python3
-"""Writes the tournament results page (docs/results/tournament.md) from a results directory:
-`actionshift summarize DIR --json` for the cells and the promotion verdict files written by
-`actionshift gate promote` (scripts/tournament) for the paired differences. It sets each reference
-cell beside the paper's Table 5 (tournament) and Table 3 (DualABI vs entropy) and marks each of the
-paper's findings reproduced, contradicted or untestable by a rule stated on the page.
-Standard library only.
-With PPO_DIR (the `tournament_ppo` results of `LEARNED=ppo scripts/learned_backbone`), the reference cells
-with the PPO backbone, the paper's own kind, are set beside the expert's and every finding is tested on both.
-usage: scripts/tournament_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS [PPO_DIR] > docs/results/tournament.md"""
-import glob
+"""Writes docs/results/tournament.md (scripts/tournament): layout of one `actionshift compare` JSON over the
+tournament's results directory (and, when given, the PPO backbone's tournament_ppo directory), pairs
+scripts/pages/tournament.pairs. Both probe rules side by side (the paper's: bare names; the project's:
+`{calibrated}`), every paper finding with its status, the probe-displacement explanation, per-split cell tables
+and the promotion audit. No statistics here.
+usage: scripts/tournament_report.py --compare FILE --commit SHA --command TEXT [--wall S] [--cores N]
+       [--displacement FILE] [--numbers FILE]"""
+import argparse
 import json
 import os
-import subprocess
 import sys
 
-results, binary, wall = sys.argv[1], sys.argv[2], sys.argv[3]
-ppo_dir = sys.argv[4] if len(sys.argv) > 4 and os.path.isdir(sys.argv[4]) else None
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-summary = json.loads(subprocess.run([binary, "summarize", results, "--json"], check=True, capture_output=True, text=True).stdout)
-cells = summary["cells"]
-by = {(c["task"], c["split"], c["method"]): c for c in cells}
-promos = {}
-for path in glob.glob(os.path.join(results, "promotion.*.json")):
-    v = json.load(open(path))
-    promos[(v["candidate"], v["baseline"])] = v
-by_ppo, promos_ppo = {}, {}
-if ppo_dir:
-    ppo_summary = json.loads(subprocess.run([binary, "summarize", ppo_dir, "--json"], check=True, capture_output=True, text=True).stdout)
-    by_ppo = {(c["task"], c["split"], c["method"]): c for c in ppo_summary["cells"] if c["backbone"] == "ppo"}
-    for path in glob.glob(os.path.join(ppo_dir, "promotion.*.json")):
-        v = json.load(open(path))
-        promos_ppo[(v["candidate"], v["baseline"])] = v
-jobs = set()
-for c in cells:
-    jobs.update(c["jobs"])
-specs = [json.load(open(os.path.join(results, j + ".summary.json")))["job"] for j in sorted(jobs)]
-profiles = sorted({s.get("profile", "?") for s in specs})
-seeds = sorted({s["seed"] for s in specs})
-commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-total = sum(c["episodes"] for c in cells)
-
-methods = ["oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes", "exact_belief", "grammar_belief", "no_adapt"]
-tasks = ["pick_cube", "push_cube", "pull_cube", "stack_cube"]
-ref_splits = ["reference_seen", "reference_unseen_composition", "reference_long_lag"]
-gen_splits = ["seen", "unseen_composition", "long_lag"]
-
-# The paper (Table 5 tournament; Table 2 Gate 1 for oracle / no_adapt): scripts/paper_numbers.py
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from paper_numbers import TABLE5 as P  # noqa: E402
+from pages import findings, fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
 
+ap = argparse.ArgumentParser()
+ap.add_argument("--compare", required=True)
+ap.add_argument("--commit", required=True)
+ap.add_argument("--command", required=True)
+ap.add_argument("--wall")
+ap.add_argument("--cores")
+ap.add_argument("--displacement", help="optional JSON {summary, rows} on the cause of the probe displacement")
+ap.add_argument("--numbers", default=paper.NUMBERS)
+a = ap.parse_args()
 
-def f3(x):
-    return "—" if x is None else f"{x:.3f}"
+c = load_comparison(a.compare)
+numbers = paper.load_numbers(a.numbers)
+specs = provenance.job_specs(c.input_dirs(), c.jobs())
+backbones = sorted(c.values("backbone"), key=lambda b: (b != "expert", b))
+out = [provenance.header(
+    "Tournament: the pool-belief ladder on the cube tasks", "scripts/tournament_report.py", a.command, a.commit,
+    c.input_dirs(), provenance.spec_values(specs, "profile"), c.seeds(), c.episodes(), jobs=len(c.jobs()),
+    episodes_per_seed=c.episodes_per_seed(), wall=a.wall, cores=a.cores, paper_source=c.paper_source(),
+    bootstrap=c.bootstrap(),
+    extra=["Experiments `configs/experiments/tournament.yaml` (expert)"
+           + (" and `configs/experiments/tournament_ppo.yaml` (PPO)" if "ppo" in backbones else "")
+           + "; backbones " + ", ".join(f"`{b}`" for b in backbones) + "; pools "
+           + ", ".join(f"`{p}`" for p in provenance.pools(specs)) + ".",
+           "Both probe rules are run: `entropy_probes` and `dualabi` are **the paper's rule**; `entropy_probes{calibrated}` "
+           "and `dualabi{calibrated}` are the project's corrected rule (docs/adapters.md, *Method names and variants*). "
+           "Only the paper's rule gets the paper's numbers.",
+           "The paper's \"seen\", \"unseen comp.\" and \"long lag\" are our `reference_*` splits (its contracts); the "
+           "generated splits have no paper counterpart."])]
 
-
-def cell_line(task, split, m):
-    c = by.get((task, split, m))
-    if not c:
-        return None
-    w = c["success_once"]
-    per = "/".join("%.3f" % s["rate"] for s in c["per_seed"])
-    p = P.get((task, split, m))
-    paper = f"{p[0]:.3f}" if p else "—"
-    paper_probe = f"{p[1]:.2f}" if p else "—"
-    flags = ", ".join("%s %d" % kv for kv in sorted(c["safety_flags"].items())) or "-"
-    return (f"| {task} | {m} | {w['rate']:.3f} [{w['lower']:.3f}, {w['upper']:.3f}] | {per} | {paper} | "
-            f"{c['mean_probe_steps']:.2f} | {paper_probe} | {c['mean_probe_displacement']:.4f} | {flags} |")
-
-
-def diff(c, b, task, split, table=None):
-    v = (promos if table is None else table).get((c, b))
-    if not v:
-        return None
-    # a cell key names its backbone when it is not the expert (`gate promote`)
-    cell = v["cells"].get(f"{task}/{split}") or v["cells"].get(f"{task}/{split}/ppo")
-    return None if not cell else cell
-
-
-print("# Tournament: the pool-belief ladder on the cube tasks\n")
-print(f"Generated by `scripts/tournament_report.py` from `{os.path.relpath(os.path.abspath(results), ROOT)}` at commit `{commit}` (do not edit by hand).\n")
-print(f"- Experiment `configs/experiments/tournament.yaml`: {len(jobs)} jobs, {total:,} episodes; simulator profile "
-      f"**{', '.join(profiles)}** (docs/sim.md); seeds {', '.join(map(str, seeds))}; 200 episodes per (task, split, method, seed);"
-      " expert backbone, live tool-frame rotation. Reference splits (two contracts each, 100 episodes per contract and seed,"
-      " as the paper) with the nine-contract pool `reference9`; generated splits (32 contracts each) with the 180-contract"
-      " `full` pool.")
-print(f"- Command: `scripts/tournament {os.path.relpath(os.path.abspath(results), ROOT)}`; wall time {int(float(wall))} s on {os.cpu_count()} cores (shared with other work).")
-print("- DualABI's threshold tau was frozen before this run by the pilot on seeds no evaluation uses (docs/results/dualabi_pilot.md).")
-print("- Paper columns: the paper's Table 5 (and Table 2 for oracle / no_adapt): frozen PPO on ManiSkill, 600 episodes per cell"
-      " (Stack: one seed, 200). The paper's \"seen\", \"unseen comp.\" and \"long lag\" are our `reference_*` splits (the same six"
-      " contracts); the generated splits have no paper counterpart.")
-print("- The `ideal` profile's earlier tournament (previous calibration protocol) is kept in docs/results/tournament_ideal.md.")
-print("- The reference cells with the learned backbones beside the expert: docs/results/learned_backbone.md (imitation MLP) and"
-      " docs/results/learned_backbone_ppo.md (PPO)" + (f"; the PPO cells on this page come from `{os.path.relpath(os.path.abspath(ppo_dir), ROOT)}`"
-      if ppo_dir else "") + ".\n")
-print("Success is success_once with its Wilson 95 % interval over the seeds; probe = mean probe steps per episode;"
-      " disp. = mean TCP translation during probes [m].\n")
-
-# ---- where the benchmark discriminates
-print("## Does the benchmark discriminate?\n")
-print("The largest belief-family spread (max - min success over exact, fixed, random, entropy, DualABI) per split, and the")
-print("paired entropy - exact difference on PickCube, from the promotion verdict files:\n")
-print("| split | pool | largest spread over the tasks | PickCube entropy - exact [95 %] |")
-print("|---|---|---|---|")
-for split in ref_splits + gen_splits:
-    best = None
-    for task in tasks:
-        rates = [by[(task, split, m)]["success_once"]["rate"] for m in methods if m not in ("oracle", "no_adapt", "grammar_belief") and (task, split, m) in by]
-        if rates and (best is None or max(rates) - min(rates) > best[0]):
-            best = (max(rates) - min(rates), task)
-    d = diff("entropy_probes", "exact_belief", "pick_cube", split)
-    ds = "—" if not d else f"{d['difference']['estimate']:+.3f} [{d['difference']['lower']:+.3f}, {d['difference']['upper']:+.3f}]"
-    pool = "reference9" if split.startswith("reference") else "full"
-    print(f"| {split} | {pool} | {best[0]:.3f} ({best[1]}) | {ds} |" if best else f"| {split} | {pool} | — | {ds} |")
-print()
-belief = [m for m in methods if m not in ("oracle", "no_adapt", "grammar_belief")]
-ref_rates = [by[(t, "reference_seen", m)]["success_once"]["rate"] for t in ("pick_cube", "push_cube", "pull_cube")
-             for m in belief if (t, "reference_seen", m) in by]
-cal = json.load(open(os.path.join(ROOT, "configs/calibration", profiles[0], "pick_cube.json")))
-snr = [abs(a) / s_ for a, s_ in zip(cal["alpha"], cal["sigma"])]
-print(f"Reading: with the expert backbone, on `reference_seen` with the nine-contract pool every belief method scores {min(ref_rates):.3f}-{max(ref_rates):.3f}"
-      " on Pick, Push and Pull, so the methods tie there. The evidence is not what makes them tie: the committed")
-print(f"calibrations follow the reference's protocol as it runs in ManiSkill (`{cal.get('protocol', '?')}`; PickCube mean R² "
-      f"{sum(cal['fit_r2']) / 6:.2f}, per-step alpha/sigma {min(snr):.1f}-{max(snr):.1f}, against 0.23 and about 1 in the paper's")
-print("ManiSkill calibration; docs/sim.md), so each belief update is about as weak as the paper's. The likely difference is")
-print("the backbone: the closed-loop scripted expert replans from the state it finds, so the few steps a belief spends on a")
-print("wrong contract cost it little, where the paper's frozen PPO policies lose up to 7 points. The brittleness page")
-print("([`brittleness.md`](brittleness.md)) runs the same adapters with the learned backbones; the PPO backbone's reference")
-print("cells are the next section. With the expert, elsewhere the methods do separate:")
-sep = []
-for split in ref_splits + gen_splits:
-    for task in tasks:
-        rs = {m: by[(task, split, m)]["success_once"]["rate"] for m in belief if (task, split, m) in by}
-        if len(rs) > 1 and max(rs.values()) - min(rs.values()) >= 0.05:
-            lo = min(rs, key=rs.get)
-            hi = max(rs, key=rs.get)
-            sep.append(f"{task}/{split}: {lo} {rs[lo]:.3f} against {hi} {rs[hi]:.3f}")
-print("" if not sep else "; ".join(sep) + ".")
-print("With the 180-contract `full` pool the passive exact belief falls behind the probing methods, and on an")
-print("all-absolute split a probe schedule that moves the arm far (entropy probing's mean displacement is in the table)")
-print("appears to disturb a stack before the belief settles.\n")
-print("How much sensor noise the reference cell needs before the belief methods separate is measured in")
-print("[`noise_sensitivity.md`](noise_sensitivity.md): pick_cube / reference_seen with `reference9`, the five belief methods,")
-print("oracle and no_adapt under the explicit, off-by-default sensor-noise knob (`run --obs-noise SIGMA`, docs/sim.md §6.1)")
-print("at a grid of noise levels fixed before the run, each with the calibration measured under the same noise and with the")
-print("built-in one, paired differences by the same bootstrap as here. The tables on this page stay noise-free.\n")
-
-# ---- the PPO backbone's reference cells
-BELIEF5 = ["exact_belief", "fixed_probes", "random_probes", "entropy_probes", "dualabi"]
-print("## The reference cells with the PPO backbone\n")
-ppo_tasks = sorted({t for (t, _, _) in by_ppo}, key=tasks.index) if by_ppo else []
-if not ppo_tasks:
-    print("Not run here (no PPO results directory was given to the report).\n")
-else:
-    missing = [t for t in ("pick_cube", "push_cube", "pull_cube") if t not in ppo_tasks]
-    print("The same cells (the paper's frozen splits, `reference9`, 3 seeds x 200 episodes, live rotation) with the frozen PPO")
-    print("backbones trained here (`train ppo`, docs/backbones.md) in place of the expert: the paper's own kind of backbone."
-          + (f" No PPO backbone passes Gate 0 on {', '.join(missing)}, so those cells are not run." if missing else ""))
-    print("Spread = max - min over the five pool-belief methods; paired differences by `actionshift gate promote` on the PPO")
-    print("records (an interval that excludes 0 separates the pair); the paper's difference beside each.\n")
-    print("| task | split | oracle | belief-family spread (lowest to highest) | paper spread | entropy - exact [95 %] | paper | DualABI - exact [95 %] | paper | expert spread |")
-    print("|---|---|---|---|---:|---|---:|---|---:|---:|")
-    ppo_sep = []
-    for task in ppo_tasks:
-        for split in ("reference_seen", "reference_unseen_composition"):
-            rs = {m: by_ppo[(task, split, m)]["success_once"]["rate"] for m in BELIEF5 if (task, split, m) in by_ppo}
-            if not rs:
-                continue
-            lo, hi = min(rs, key=rs.get), max(rs, key=rs.get)
-            pr = [P[(task, split, m)][0] for m in BELIEF5 if (task, split, m) in P]
-            er = [by[(task, split, m)]["success_once"]["rate"] for m in BELIEF5 if (task, split, m) in by]
-            o = by_ppo.get((task, split, "oracle"))
-
-            def dtext(c, b):
-                d = diff(c, b, task, split, promos_ppo)
-                if not d:
-                    return "—"
-                e = d["difference"]
-                return f"{e['estimate']:+.3f} [{e['lower']:+.3f}, {e['upper']:+.3f}]" + (" **excl. 0**" if e["lower"] > 0 or e["upper"] < 0 else "")
-
-            def pdiff(c, b):
-                return f"{P[(task, split, c)][0] - P[(task, split, b)][0]:+.3f}" if (task, split, c) in P and (task, split, b) in P else "—"
-            print(f"| {task} | {split} | {f3(o['success_once']['rate'] if o else None)} | {rs[hi] - rs[lo]:.3f} ({lo} {rs[lo]:.3f} to {hi} {rs[hi]:.3f}) | "
-                  f"{f3(max(pr) - min(pr) if pr else None)} | {dtext('entropy_probes', 'exact_belief')} | {pdiff('entropy_probes', 'exact_belief')} | "
-                  f"{dtext('dualabi', 'exact_belief')} | {pdiff('dualabi', 'exact_belief')} | {f3(max(er) - min(er) if er else None)} |")
-            ppo_sep.append((task, split, rs[hi] - rs[lo], max(er) - min(er) if er else None))
-    print()
-    wide = [f"{t}/{sp} {a:.3f} (expert {f3(b)})" for t, sp, a, b in ppo_sep]
-    print("Reading: with the PPO backbone the belief-family spreads are " + ", ".join(wide) + ". The methods that tie with the")
-    print("expert separate with a frozen PPO policy, as the paper's do. The likely mechanism (not isolated here): a belief that")
-    print("decodes a few steps under a wrong contract, or a probe that moves the arm, leaves the PPO in states its training")
-    print("never visited, where the replanning expert recovers. The ordering of the methods is a finding of its own, tested")
-    print("against the paper's in the next section.")
-    disp = []
-    for m in ("entropy_probes", "fixed_probes", "random_probes", "dualabi"):
-        cs = [by_ppo[(t, sp, m)] for t in ppo_tasks for sp in ("reference_seen", "reference_unseen_composition") if (t, sp, m) in by_ppo]
-        if cs:
-            n = sum(c["episodes"] for c in cs)
-            disp.append(f"{m} {sum(c['mean_probe_displacement'] * c['episodes'] for c in cs) / n:.4f} m in "
-                        f"{sum(c['mean_probe_steps'] * c['episodes'] for c in cs) / n:.2f} steps")
-    print("Mean TCP travel during probes per episode with the PPO backbone (these cells): " + ", ".join(disp) + ". Entropy probing")
-    print("chooses the most informative probes, which here are also the ones that move the arm farthest, and the PPO is")
-    print("the backbone least able to recover from them.\n")
+# ---- the headline difference
+out.append("## Entropy − fixed probes on pick_cube / reference_seen\n\n")
+out.append("The paper's headline probing result (§5.2, Table 7) against ours, both probe rules, every backbone run here:\n\n")
+out.append(sections.headline_table(c, backbones))
 
 # ---- findings
-print("## The paper's findings, tested\n")
-print("Rule (fixed in this script): a finding about a paired difference is **reproduced** when our paired 95 % bootstrap")
-print("interval (3 seeds x 200 episodes, `actionshift gate promote`) supports the same conclusion as the paper's (the same sign")
-print("excluded from zero, or a tie when the paper reports a tie); **contradicted** otherwise, with the reason; **untestable** when")
-print("the cell cannot be measured here.\n")
-findings = [
-    ("entropy probing beats fixed probes on Pick/seen (+5.8 [+3.7, +8.2])", "entropy_probes", "fixed_probes", "pick_cube", "reference_seen", "pos"),
-    ("entropy probing beats fixed probes on Pull/unseen (+5.5 [+3.3, +7.8])", "entropy_probes", "fixed_probes", "pull_cube", "reference_unseen_composition", "pos"),
-    ("entropy probing beats fixed probes on Push/seen (+1.8 [+0.8, +3.0], below the 5-point margin)", "entropy_probes", "fixed_probes", "push_cube", "reference_seen", "pos"),
-    ("entropy probing beats the passive exact belief on Pick/seen (+5.8)", "entropy_probes", "exact_belief", "pick_cube", "reference_seen", "pos"),
-    ("entropy probing beats the passive exact belief on Pull/unseen (+4.7 [+2.5, +7.0])", "entropy_probes", "exact_belief", "pull_cube", "reference_unseen_composition", "pos"),
-    ("random probes are worse than the passive exact belief on Push/seen (-4.2 [-6.3, -2.0])", "random_probes", "exact_belief", "push_cube", "reference_seen", "neg"),
-    ("DualABI ties entropy probing on success, Pick/seen (-0.3 [-1.7, +1.0])", "dualabi", "entropy_probes", "pick_cube", "reference_seen", "tie"),
-    ("DualABI ties entropy probing on success, Pick/unseen (+0.8 [-0.7, +2.3])", "dualabi", "entropy_probes", "pick_cube", "reference_unseen_composition", "tie"),
-    ("DualABI ties entropy probing on success, Push/seen (+0.0)", "dualabi", "entropy_probes", "push_cube", "reference_seen", "tie"),
-    ("DualABI ties entropy probing on success, Push/unseen (+0.7 [-0.3, +1.8])", "dualabi", "entropy_probes", "push_cube", "reference_unseen_composition", "tie"),
-    ("DualABI beats fixed probes on Pick/seen (+5.5 [+3.2, +7.8])", "dualabi", "fixed_probes", "pick_cube", "reference_seen", "pos"),
-]
-print("| finding (paper) | expert: candidate / baseline | expert: paired difference [95 %] | expert: status | reason | PPO: candidate / baseline | PPO: paired difference [95 %] | PPO: status |")
-print("|---|---|---|---|---|---|---|---|")
+out.append("\n## The paper's findings, tested\n\n" + sections.STATUS_RULE + "\n\n")
+out.append(sections.findings_table(c, numbers, backbones))
+out.append("\nProbe cost (the paper's §5.5: DualABI probes less than entropy probing). Compare gives mean probe steps and "
+           "displacement per cell, no interval for their difference, so this is descriptive:\n\n")
+rows = []
+for x in sections.ordered_cells(c):
+    if x["method"].split("{")[0] in ("dualabi", "entropy_probes") and x["split"].startswith("reference") \
+            and x["split"] != "reference_long_lag":
+        rows.append([x["task"], x["split"], x["backbone"], f"`{x['method']}`", fmt.probe_steps(x),
+                     paper.cell_column(x, "mean_probe_steps"), fmt.displacement(x)])
+out.append(table.markdown(["task", "split", "backbone", "method", "probe steps", "paper probe steps",
+                           "displacement [m]"], rows) if rows else "No probing cells.\n")
+agg = [numbers.by_id(i) for i in ("s5.5.aggregate.entropy_probes.mean_probe_displacement",
+                                  "s5.5.aggregate.dualabi.mean_probe_displacement")]
+agg = [e for e in agg if e]
+if agg:
+    out.append("\nThe paper's displacement is printed only as an aggregate over Pick/Push seen and unseen composition ("
+               + agg[0]["source"] + "): " + ", ".join(f"{e['method']} {paper.entry_value(e)} m" for e in agg)
+               + "; the paper-numbers file has no per-cell displacement.\n")
 
+# ---- displacement
+out.append("\n## Why entropy probes move the arm more than the paper's\n\n")
+cell = {m: c.cell("pick_cube", "reference_seen", m, "expert")
+        for m in ("entropy_probes", "entropy_probes{calibrated}", "fixed_probes", "random_probes", "dualabi", "dualabi{calibrated}")}
+if cell["entropy_probes"] and cell["fixed_probes"]:
+    pe = paper.cell_entry(cell["entropy_probes"], "mean_probe_displacement")
+    pf = paper.cell_entry(cell["fixed_probes"], "mean_probe_displacement")
+    out.append(
+        f"On pick_cube / reference_seen with the expert, entropy probing moves the TCP {fmt.displacement(cell['entropy_probes'])} m "
+        f"per episode under the paper's rule" + (f" and {fmt.displacement(cell['entropy_probes{calibrated}'])} m under `{{calibrated}}`"
+                                                 if cell["entropy_probes{calibrated}"] else "")
+        + f", in {fmt.probe_steps(cell['entropy_probes'])} probe steps; fixed probes move it {fmt.displacement(cell['fixed_probes'])} m in "
+        f"{fmt.probe_steps(cell['fixed_probes'])} steps. "
+        + ("The paper-numbers file has no per-cell displacement for this cell, so the paper's values cannot be set "
+           "beside these from it" if not (pe or pf) else
+           f"The paper: entropy {paper.entry_value(pe)} m, fixed {paper.entry_value(pf)} m")
+        + ". Both of our rules choose probes that travel farther than fixed probes, so the difference between our "
+        "entropy displacement and the paper's does not come from the `{calibrated}` changes (which alter which probe "
+        "is chosen, not how far a probe moves); where it does come from is being measured separately (below, when "
+        "available).\n\n")
+    out.append(table.markdown(["method", "probe steps", "displacement [m]", "paper displacement"],
+                              [[f"`{m}`", fmt.probe_steps(x), fmt.displacement(x),
+                                paper.cell_column(x, "mean_probe_displacement", 4)] for m, x in cell.items() if x]))
+else:
+    out.append("pick_cube / reference_seen with the expert was not run with both entropy and fixed probes.\n")
+if a.displacement and os.path.exists(a.displacement):
+    with open(a.displacement) as f:
+        d = json.load(f)
+    out.append(f"\n<!-- displacement slot: from {a.displacement} -->\n**The measured cause** (from `{a.displacement}`):\n\n"
+               + d["summary"].rstrip() + "\n")
+    r = d.get("rows") or []
+    if r and isinstance(r[0], dict):
+        keys = list(r[0].keys())
+        out.append("\n" + table.markdown(keys, [[row.get(k) for k in keys] for row in r]))
+    out.append("<!-- end of displacement slot -->\n")
 
-def judge(d, kind):
-    e = d["difference"]
-    lo, hi = e["lower"], e["upper"]
-    return (kind == "pos" and lo > 0) or (kind == "neg" and hi < 0) or (kind == "tie" and lo <= 0 <= hi)
+# ---- cells per split
+for split in sections.splits(c):
+    out.append(f"\n## {split}\n\n")
+    out.append(sections.cells_table(c, sections.ordered_cells(c, split=split)))
 
-
-def ppo_cols(c, b, task, split, kind):
-    d = diff(c, b, task, split, promos_ppo)
-    if d is None:
-        return "— | — | untestable (no PPO cell)"
-    e = d["difference"]
-    ok = judge(d, kind)
-    return (f"{d['candidate_success']:.3f} / {d['baseline_success']:.3f} | {e['estimate']:+.3f} [{e['lower']:+.3f}, {e['upper']:+.3f}] | "
-            f"**{'reproduced' if ok else 'contradicted'}**")
-
-
-for text, c, b, task, split, kind in findings:
-    d = diff(c, b, task, split)
-    if d is None:
-        print(f"| {text} | — | — | untestable | cell not run | {ppo_cols(c, b, task, split, kind)} |")
-        continue
-    e = d["difference"]
-    lo, hi = e["lower"], e["upper"]
-    ok = (kind == "pos" and lo > 0) or (kind == "neg" and hi < 0) or (kind == "tie" and lo <= 0 <= hi)
-    reason = ""
-    if not ok:
-        cs, bs = d["candidate_success"], d["baseline_success"]
-        if min(cs, bs) >= 0.98:
-            reason = (f"both at the ceiling ({cs:.3f} vs {bs:.3f}): with the closed-loop expert as the backbone a few steps"
-                      " on a wrong contract do not cost the episode (see the reading above)")
-        elif kind == "tie":
-            reason = f"a paired difference of {e['estimate']:+.3f} excludes zero here"
-        else:
-            reason = f"our interval [{lo:+.3f}, {hi:+.3f}] does not support it ({cs:.3f} vs {bs:.3f})"
-    print(f"| {text} | {d['candidate_success']:.3f} / {d['baseline_success']:.3f} | {e['estimate']:+.3f} [{lo:+.3f}, {hi:+.3f}] | "
-          f"**{'reproduced' if ok else 'contradicted'}** | {reason} | {ppo_cols(c, b, task, split, kind)} |")
-# probe-cost finding (Table 3 aggregate)
-def probe_agg(table):
-    """(DualABI steps, entropy steps, DualABI displacement, entropy displacement) over Pick/Push seen/unseen."""
-    agg = {"dualabi": [0, 0.0, 0.0], "entropy_probes": [0, 0.0, 0.0]}
-    for m in agg:
-        for task in ("pick_cube", "push_cube"):
-            for split in ("reference_seen", "reference_unseen_composition"):
-                c = table.get((task, split, m))
-                if c:
-                    agg[m][0] += c["episodes"]
-                    agg[m][1] += c["mean_probe_steps"] * c["episodes"]
-                    agg[m][2] += c["mean_probe_displacement"] * c["episodes"]
-    if not agg["dualabi"][0] or not agg["entropy_probes"][0]:
-        return None
-    a, e = agg["dualabi"], agg["entropy_probes"]
-    return a[1] / a[0], e[1] / e[0], a[2] / a[0], e[2] / e[0]
-
-
-def probe_text(x):
-    dp, ep, dd, ed = x
-    return f"{dp:.2f} vs {ep:.2f} steps ({(dp / ep - 1) * 100:+.0f} %); {dd:.4f} vs {ed:.4f} m ({(dd / ed - 1) * 100:+.0f} %)"
-
-
-pe, pp = probe_agg(by), probe_agg(by_ppo)
-if pe:
-    ok = pe[0] < pe[1]
-    ppo_part = "— | — | untestable (no PPO cell)" if not pp else f"{probe_text(pp)} | — | **{'reproduced' if pp[0] < pp[1] else 'contradicted'}**"
-    print(f"| DualABI uses fewer probe steps than entropy probing (Table 3 aggregate over Pick/Push seen/unseen: 2.89 vs 6.00, -52 %;"
-          f" displacement 0.0154 vs 0.0267 m, -42 %) | {probe_text(pe)} | — | **{'reproduced' if ok else 'contradicted'}** |"
-          f" {'' if ok else 'DualABI probed as much as entropy'} | {ppo_part} |")
-ll = [by.get((t, "reference_long_lag", m)) for t in tasks for m in methods if m not in ("oracle", "no_adapt")]
-ll = [c for c in ll if c]
-if ll:
-    top = max(c["success_once"]["rate"] for c in ll)
-    orc = max((by[(t, "reference_long_lag", "oracle")]["success_once"]["rate"] for t in tasks if (t, "reference_long_lag", "oracle") in by), default=None)
-    print(f"| no pool-belief method solves long lag (paper: 0.02-0.33, at the oracle's own low level) | best belief method {top:.3f};"
-          f" best oracle {f3(orc)} | — | **{'reproduced' if top <= 0.5 else 'contradicted'}** | | — | — | not run with PPO (its long-lag cells are docs/results/long_lag.md) |")
-print()
-
-for split in ref_splits + gen_splits:
-    pool = "reference9" if split.startswith("reference") else "full"
-    print(f"## {split} (pool `{pool}`)\n")
-    print("| task | method | success [Wilson 95 %] | per seed | paper | probe | paper probe | disp. [m] | safety flags |")
-    print("|---|---|---|---|---:|---:|---:|---:|---|")
-    for task in tasks:
-        for m in methods:
-            line = cell_line(task, split, m)
-            if line:
-                print(line)
-    print()
-    # spread of the belief family, per task
-    for task in tasks:
-        rates = [(m, by[(task, split, m)]["success_once"]["rate"]) for m in methods if m not in ("oracle", "no_adapt", "grammar_belief") and (task, split, m) in by]
-        if rates:
-            lo = min(rates, key=lambda x: x[1]); hi = max(rates, key=lambda x: x[1])
-            if hi[1] - lo[1] < 1e-12:
-                print(f"- {task}: belief-family spread 0.000 (every method {hi[1]:.3f}).")
-            else:
-                print(f"- {task}: belief-family spread {hi[1] - lo[1]:.3f} ({lo[0]} {lo[1]:.3f} to {hi[0]} {hi[1]:.3f}).")
-    print()
-
-print("## Paired differences and promotion verdicts (computed by `actionshift gate promote`)\n")
-print("Rules (`include/actionshift/eval/gates.hpp`): a one-seed result under 0.3 is pruned; a safety regression rejects;")
-print("fewer than three matched seeds asks for more seeds; otherwise the candidate is promoted on >= 5 points over its")
-print("matched baseline with the paired 95 % bootstrap interval above 0, or on a success-vs-probe-cost Pareto point (fewer")
-print("mean probe steps, a paired success estimate >= 0, and candidate success >= 0.3, so a tie at 0.000 promotes nothing);")
-print("else rejected. Every verdict is listed.\n")
-for (c, b) in sorted(promos):
-    v = promos[(c, b)]
-    print(f"### {c} vs {b}\n")
-    print("| cell | candidate | baseline | difference [95 % CI] | probe steps (cand / base) | episodes | verdict |")
-    print("|---|---:|---:|---|---|---:|---|")
-    counts = {}
-    for key in sorted(v["cells"]):
-        x = v["cells"][key]
-        d = x["difference"]
-        counts[x["verdict"]] = counts.get(x["verdict"], 0) + 1
-        print(f"| {key} | {x['candidate_success']:.3f} | {x['baseline_success']:.3f} | {d['estimate']:+.3f} "
-              f"[{d['lower']:+.3f}, {d['upper']:+.3f}] | {x['candidate_probe_steps']:.2f} / {x['baseline_probe_steps']:.2f} | "
-              f"{x.get('episodes', '—')} | **{x['verdict']}** |")
-    print("\n" + ", ".join(f"{k}: {n}" for k, n in sorted(counts.items())) + "\n")
+# ---- promotion audit
+out.append("\n## Paired differences and promotion verdicts\n\n" + sections.PROMOTION_RULES + "\n\n")
+out.append(sections.promotion_table(c))
+one_side = [(p, x) for p in c.pairs for x in p["cells_with_one_side"]]
+if one_side:
+    out.append("\nCells where a pair has only one side (not compared): "
+               + "; ".join(f"`{p['candidate']}` vs `{p['baseline']}` at {x['task']}/{x['split']}/{x['backbone']} "
+                           f"(only `{x['present']}`)" for p, x in one_side) + ".\n")
+if c.notes():
+    out.append("\nNotes from `compare`: " + "; ".join(c.notes()) + "\n")
+sys.stdout.write("".join(out))

@@ -36,7 +36,7 @@ def status(cmp, missing="the cell was not run here"):
             return REPRODUCED, f"our difference {ours} includes 0, as the paper's {theirs} (a tie)"
         return CONTRADICTED, f"our difference {ours} excludes 0 where the paper's {theirs} is a tie"
     note = p.get("entry", {}).get("note", "")
-    return UNTESTABLE, f"the paper gives {theirs} without an interval or significance" + (f" ({note})" if note else "")
+    return UNTESTABLE, f"the source gives {fmt.signed(p['value'])} without an interval or significance" + (f" ({note})" if note else "")
 
 
 def bold(s):

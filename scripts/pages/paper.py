@@ -91,6 +91,39 @@ class Numbers:
                 return e
         return any_backbone
 
+    def find_difference(self, task, split, candidate, baseline, backbone):
+        """The difference entry candidate − baseline compare would attach (no `variant`; a backbone-listing entry
+        first) and whether it is stored reversed (baseline − candidate); (None, False) when none."""
+        if "{" in candidate or "{" in baseline:
+            return None, False
+        found = None
+        for e in self.entries:
+            if e["kind"] != "difference" or e.get("variant") or e.get("task") != task or e.get("split") != split:
+                continue
+            if (e["candidate"], e["baseline"]) == (candidate, baseline):
+                rev = False
+            elif (e["candidate"], e["baseline"]) == (baseline, candidate):
+                rev = True
+            else:
+                continue
+            bbs = e.get("backbones")
+            if bbs is not None and backbone in bbs:
+                return e, rev
+            if bbs is None and found is None:
+                found = (e, rev)
+        return found or (None, False)
+
+
+def entry_diff_value(e, reversed_=False, digits=3):
+    """A numbers.json difference entry as `+0.058 [+0.037, +0.082]`, oriented candidate − baseline (negated when
+    reversed_: a sign flip of what the paper printed, not a computation)."""
+    if not e:
+        return fmt.DASH
+    s = -1 if reversed_ else 1
+    p = {"value": s * e["value"], "significant": e.get("significant"),
+         "interval": None if not e.get("interval") else sorted([s * e["interval"][0], s * e["interval"][1]])}
+    return diff_value(p, digits)
+
 
 def load_numbers(path=NUMBERS):
     return Numbers(path)

@@ -26,6 +26,11 @@ def spec_values(specs, key, default="?"):
     return sorted({str(s.get(key, default)) for s in specs})
 
 
+def pools(specs):
+    """Distinct pool names of job specs (`none` for jobs without a pool), sorted."""
+    return sorted({(s.get("pool") or {}).get("name", "none") for s in specs})
+
+
 def wall_text(wall, cores=None, extra=""):
     """`wall time 570 s on 2 cores` ("not measured" when wall is None or empty)."""
     if wall in (None, ""):
