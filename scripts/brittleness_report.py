@@ -1,146 +1,117 @@
 #!/usr/bin/env python3
-"""Writes docs/results/brittleness.md from scripts/brittleness's results: per task and backbone, clean
-success (Gate 0's unwrapped run), hidden with no adaptation, and restored by each adapter, pooled over
-three seeds with Wilson 95 % intervals and mean probe steps, beside the paper's section 5.8 numbers.
-Standard library only.
-usage: scripts/brittleness_report.py RESULTS_DIR WALL_SECONDS THREADS [CPU] > docs/results/brittleness.md
-(CPU: the `times` line of the runs, e.g. "2m19.630s 0m10.540s")"""
-import glob, json, math, os, subprocess, sys
-from collections import defaultdict
-
-results, wall, threads = sys.argv[1], sys.argv[2], sys.argv[3]
-CPU = sys.argv[4] if len(sys.argv) > 4 else ""
-WALL_TEXT = wall + " s" if wall.replace(".", "", 1).isdigit() else wall  # a number, or a sentence for resumed runs
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-METHODS = ["no_adapt", "oracle", "entropy_probes", "dualabi", "grammar_belief"]
-BACKBONES = [("expert", "scripted"), ("mlp", "imitation (DAgger MLP)"), ("ppo", "RL (PPO)")]
-
+"""Writes docs/results/brittleness.md: per task and backbone, clean success (Gate 0's unwrapped runs, one
+verdict file per seed), hidden with no adaptation, and restored by each adapter label, beside the paper's
+numbers. Layout only: every rate, interval, difference and verdict is from `actionshift compare` (the
+cells and the pairs of scripts/brittleness.pairs) or from a Gate 0 verdict file; the paper's numbers from
+compare's paper fields or, for the Diffusion Policy scalars, configs/paper/numbers.json by id.
+usage: scripts/brittleness_report.py COMPARE_JSON RESULTS_DIR [--commit C --command CMD --wall S --cores N --cpu TIMES]"""
+import glob
+import json
+import os
+import re
+import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report_util import cpu_text  # noqa: E402
+from pages import findings, fmt, load_comparison, paper, provenance, table  # noqa: E402
+from pages.rest_util import cpu_text, commit_of, parser, probe_rule, rel, scalar  # noqa: E402
+
+BACKBONES = [("expert", "scripted"), ("mlp", "imitation (DAgger MLP)"), ("ppo", "RL (PPO)")]
+ORDER = ["no_adapt", "oracle", "entropy_probes", "entropy_probes{calibrated}", "dualabi", "dualabi{calibrated}",
+         "grammar_belief"]
+DP_IDS = ["s5.8.pick_cube.diffusion_policy.clean_success", "s5.8.push_cube.diffusion_policy.clean_success",
+          "s5.8.diffusion_policy.no_adapt", "abstract.no_adapt.success_once_floor_min", "abstract.no_adapt.success_once_floor_max",
+          "s5.8.diffusion_policy.restored_success_min", "s5.8.diffusion_policy.restored_success_max",
+          "s5.8.diffusion_policy.dualabi.probe_steps_seen"]
 
 
-def wilson(k, n, z=1.959963984540054):
-    if n == 0:
-        return None
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return p, max(0.0, c - h), min(1.0, c + h), n
+def main():
+    ap = parser(__doc__)
+    ap.add_argument("compare")
+    ap.add_argument("results")
+    a = ap.parse_args()
+    C = load_comparison(a.compare)
+    numbers = paper.load_numbers()
+    res = rel(a.results)
+    specs = provenance.job_specs([a.results], C.jobs())
+    clean = {}  # (backbone, task) -> [(seed, cell of the verdict file)]
+    for f in sorted(glob.glob(os.path.join(a.results, "clean", "*.json"))):
+        with open(f) as fh:
+            v = json.load(fh)
+        for c in v["cells"].values():
+            clean.setdefault((c["backbone"], c["task"]), []).append((c["seed"], c))
+    out = [provenance.header(
+        "Brittleness: scripted, imitation and RL backbones under the same hidden contracts",
+        "scripts/brittleness_report.py", a.command or f"scripts/brittleness {res}", commit_of(a), [res],
+        provenance.spec_values(specs, "profile"), C.seeds(), C.episodes(), jobs=len(C.jobs()),
+        episodes_per_seed=C.episodes_per_seed(), wall=a.wall, cores=a.cores, paper_source=C.paper_source(),
+        bootstrap=C.bootstrap(),
+        extra=[f"CPU: {cpu_text(a.cpu)[2:] or 'not measured'}.",
+               "Clean: Gate 0's unwrapped run (`actionshift gate0 --seed S`, one verdict file per seed in "
+               f"`{res}/clean/`), shown per seed with the Wilson interval the verdict file holds (compare does not read "
+               "verdict files, so no pooled clean rate is shown)."])]
+    w = out.append
+    w("The paper's claim (§5.8): brittleness is interface-semantic, not paradigm-specific. A frozen imitation policy\n"
+      "(Diffusion Policy) collapses under the same hidden contracts that zero the frozen PPO policy, and the same\n"
+      "policy-agnostic adapters restore it to its own oracle ceiling. Here each backbone runs clean, behind the hidden\n"
+      "contracts of `reference_seen` with no adaptation, and through the same adapters: the oracle, entropy probing and\n"
+      "DualABI over the `reference9` pool, each with the paper's probe rule (the bare name) and the project's\n"
+      "`{calibrated}` rule (docs/adapters.md), and the pool-free grammar belief. What each label ran is read from the\n"
+      "label (column `what ran`). The paper column is the paper's frozen PPO (Table 2, Table 5) for the bare labels;\n"
+      "a `{...}` label has no paper number.\n")
+    for task in C.values("task"):
+        w(f"## {task}\n")
+        rows = []
+        for bb, paradigm in BACKBONES:
+            cells = C.cells_where(task=task, backbone=bb)
+            if not cells and (bb, task) not in clean:
+                continue
+            for seed, v in clean.get((bb, task), []):
+                rows.append([f"`{bb}`", paradigm, "clean (Gate 0, unwrapped)", f"seed {seed}",
+                             fmt.rate(v["competence"]["interval"]), fmt.DASH, fmt.DASH, fmt.DASH,
+                             paper.entry_value(numbers.by_id(f"table1.{task}.clean_success"))])
+            labels = [m for m in ORDER if C.cell(task, "reference_seen", m, bb)]
+            labels += [m for m in C.values("method", cells) if m not in labels]
+            for m in labels:
+                c = C.cell(task, "reference_seen", m, bb)
+                if not c:
+                    continue
+                rows.append([f"`{bb}`", paradigm, f"`{m}`", probe_rule(m) if probe_rule(m) != m else fmt.DASH, fmt.cell_rate(c), fmt.per_seed(c),
+                             fmt.probe_steps(c), fmt.safety(c), paper.cell_column(c)])
+        w(table.markdown(["backbone", "paradigm", "label", "what ran", "success (Wilson 95 %)", "per seed",
+                          "probe steps", "flagged episodes", "paper (frozen PPO)"], rows,
+                         ["l", "l", "l", "l", "l", "l", "r", "l", "l"]))
+        w("")
+    w("## Paired differences\n")
+    w("Every pair of `scripts/brittleness.pairs` in every backbone that ran both labels (candidate − baseline over the same"
+      " episodes), with the promotion gate's verdict and the paper's difference where the paper gives one.\n")
+    rows = []
+    for cmp in C.comparisons:
+        v, rule, _ = fmt.promotion(cmp)
+        rows.append([cmp["task"], f"`{cmp['backbone']}`", f"`{cmp['candidate']}` − `{cmp['baseline']}`", fmt.cmp_rates(cmp),
+                     fmt.cmp_diff(cmp, mark=True), fmt.per_seed_diff(cmp), paper.cmp_column(cmp), f"{v} ({rule})"])
+    w(table.markdown(["task", "backbone", "pair", "success: candidate / baseline", "difference [95 %]", "per seed",
+                      "paper", "promotion"], rows))
+    w("")
+    w("## The paper's findings\n")
+    w("Status from compare's fields (scripts/pages/findings.py): a finding whose paper difference is significant is"
+      " reproduced only when ours excludes 0 with the same sign (compare's `sign_agreement`).\n")
+    items = [(f"the hidden contract collapses `{c['backbone']}` and the oracle restores it ({c['task']})", c)
+             for c in C.comparisons_where(candidate="oracle", baseline="no_adapt")]
+    items += [(f"{findings.describe(c)} (`{c['backbone']}`)", c) for c in C.comparisons
+              if c.get("paper") and c["candidate"] != "oracle"]
+    w(findings.findings_table(items) if items else "No pair with a paper difference was run.\n")
+    w("")
+    w("## The paper's Diffusion Policy numbers (§5.8)\n")
+    w("The paper's imitation backbone is a Diffusion Policy (ours: the DAgger MLP). From configs/paper/numbers.json by id:\n")
+    rows = [[f"`{i}`", (numbers.by_id(i) or {}).get("quantity", fmt.DASH), scalar(numbers, i),
+             (numbers.by_id(i) or {}).get("note", "")] for i in DP_IDS]
+    w(table.markdown(["id", "quantity", "value (source)", "note"], rows))
+    w("")
+    w("## Backbone identities\n")
+    sha = sorted({(s["backbone"]["name"], s["task"], s["backbone"]["sha256"]) for s in specs})
+    w(table.markdown(["backbone", "task", "sha256"], [[f"`{b}`", t, f"`{h}`"] for b, t, h in sha]))
+    print(re.sub(r"\n{3,}", "\n\n", "\n".join(out)).rstrip("\n"))
 
 
-def fmt(w):
-    return "—" if w is None else f"{w[0]:.3f} [{w[1]:.3f}, {w[2]:.3f}]"
-
-
-# clean: Gate 0 verdict files clean/<backbone>.<task>.<seed>.json (unwrapped competence run)
-clean = defaultdict(lambda: [0, 0])
-clean_sha = {}
-for f in sorted(glob.glob(os.path.join(results, "clean", "*.json"))):
-    v = json.load(open(f))
-    for cell in v["cells"].values():
-        i = cell["competence"]["interval"]
-        key = (cell["backbone"], os.path.basename(f).split(".")[1])
-        clean[key][0] += i["successes"]
-        clean[key][1] += i["total"]
-        clean_sha[key] = cell["backbone_sha256"]
-# hidden: episode records
-cells = defaultdict(lambda: [0, 0, 0.0])
-specs, sha = [], {}
-for path in sorted(glob.glob(os.path.join(results, "*.summary.json"))):
-    s = json.load(open(path))
-    if not s.get("complete"):
-        continue
-    specs.append(s["job"])
-    j = s["job"]
-    sha[(j["backbone"]["name"], j["task"])] = j["backbone"]["sha256"]
-    with open(path.replace(".summary.json", ".jsonl")) as f:
-        for line in f:
-            r = json.loads(line)
-            c = cells[(r["backbone"], r["task"], r["method"])]
-            c[0] += int(r["success_once"])
-            c[1] += 1
-            c[2] += r["probe_steps"]
-tasks = sorted({t for (_, t, _) in cells})
-seeds = sorted({s["seed"] for s in specs})
-eps = sorted({s["episodes"] for s in specs})
-profiles = sorted({s.get("profile", "?") for s in specs})
-print("# Brittleness: scripted, imitation and RL backbones under the same hidden contracts\n")
-print(f"Generated by `scripts/brittleness_report.py` from `{results}` at commit `{commit}` (do not edit by hand).\n")
-print("The paper's claim (§5.8): brittleness is interface-semantic, not paradigm-specific. A frozen imitation policy")
-print("(Diffusion Policy) collapses under the same hidden contracts that zero the frozen PPO policy, and the same")
-print("policy-agnostic adapters restore it to its own oracle ceiling. Here each backbone is run clean (Gate 0's unwrapped")
-print("environment), behind the hidden contracts with no adaptation, and through the same adapters with the same")
-print("parameters (docs/adapters.md): the privileged oracle, entropy probing and DualABI over the `reference9` pool, and")
-print("the pool-free grammar belief. The imitation backbone is the project's DAgger MLP (the paper's is a Diffusion")
-print("Policy); the RL backbone is `train ppo`'s actor, where one is committed (docs/backbones.md).\n")
-print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} scripts/brittleness {results}`; {len(specs)} jobs + the clean Gate 0 runs;"
-      f" wall time {WALL_TEXT} on {threads} thread(s) of a shared {os.cpu_count()}-core machine (load average {os.getloadavg()[1]:.1f} over the last 5 minutes at the end){cpu_text(CPU)}.")
-print(f"- Simulator profile **{', '.join(profiles)}**; split `reference_seen` (the paper's two seen contracts); seeds"
-      f" {', '.join(map(str, seeds))}; {', '.join(map(str, eps))} episodes per job (half per contract), so"
-      f" {3 * eps[0] if eps else 0} episodes per cell; clean = the same number of unwrapped Gate 0 episodes per seed.")
-print("- Success is success_once with its Wilson 95 % interval pooled over the seeds; `probe` = mean probe steps per episode;")
-print("  'restored / clean' = the adapter's success over the backbone's own clean success.\n")
-PAPER = ("Paper (§5.8, Table 2, Table 3): frozen PPO clean 1.000 on Pick and Push; hidden, no adaptation 0.000 (Pick) and"
-         " 0.003 (Push); oracle 1.000 / 1.000; entropy 0.987 / 1.000; DualABI 0.983 (2.78 probe steps) / 1.000 (2.60)."
-         " Frozen Diffusion Policy clean 0.580 / 0.670; hidden ~0.003 (the same 0.000-0.007 floor); restored by the same"
-         " adapters to its oracle ceiling, 0.62-0.735; DualABI 0.0 probe steps on seen. The paper has no grammar belief.")
-for task in tasks:
-    print(f"## {task}\n")
-    print("| backbone | paradigm | clean (Gate 0) | no_adapt | oracle | entropy_probes (probe) | dualabi (probe) | grammar_belief (probe) | best restored / clean |")
-    print("|---|---|---|---|---|---|---|---|---:|")
-    for bb, paradigm in BACKBONES:
-        if not any((bb, task, m) in cells for m in METHODS):
-            continue
-        c = clean.get((bb, task))
-        cw = wilson(*c) if c else None
-        row = [f"`{bb}`", paradigm, fmt(cw)]
-        best = 0.0
-        for m in METHODS:
-            k = cells.get((bb, task, m))
-            w = wilson(k[0], k[1]) if k else None
-            cellstr = fmt(w)
-            if k and m in ("entropy_probes", "dualabi", "grammar_belief"):
-                cellstr += f" ({k[2] / k[1]:.2f})"
-            if w and m != "no_adapt" and m != "oracle":
-                best = max(best, w[0])
-            row.append(cellstr)
-        row.append("—" if not cw or cw[0] == 0 else f"{best / cw[0]:.2f}")
-        print("| " + " | ".join(row) + " |")
-    print()
-print("## Reading\n")
-for task in tasks:
-    for bb, paradigm in BACKBONES:
-        c = clean.get((bb, task))
-        na, orc = cells.get((bb, task, "no_adapt")), cells.get((bb, task, "oracle"))
-        if not c or not na or not orc:
-            continue
-        cw, nw, ow = wilson(*c), wilson(na[0], na[1]), wilson(orc[0], orc[1])
-        overlap = ow[1] <= cw[2] and cw[1] <= ow[2]
-        print(f"- {task}, {paradigm}: clean {cw[0]:.3f} -> hidden {nw[0]:.3f} -> oracle {ow[0]:.3f}"
-              f" ({'within' if overlap else 'outside'} the clean interval).")
-    g0 = os.path.join(ROOT, "configs/gates/gate0", f"ppo.{task}.json")
-    if os.path.exists(g0):
-        v = next(iter(json.load(open(g0))["cells"].values()))
-        i = v["competence"]["interval"]
-        if v["decision"] == "advance":
-            print(f"- The `ppo` backbone on {task} is **advance** at Gate 0 ({i['rate']:.3f} over {i['total']} episodes,"
-                  " configs/gates/gate0/): a competent frozen PPO, the paper's own kind of backbone"
-                  + ("." if i["rate"] >= 0.95 else f", though below the 0.95 aim and the paper's 1.00 (docs/backbones.md)."))
-        else:
-            print(f"- The `ppo` backbone on {task} is **{v['decision']}** at Gate 0 ({i['rate']:.3f} over {i['total']} episodes,"
-                  " configs/gates/gate0/): a weak backbone, shown because the collapse-and-restore pattern is about the")
-            print("  interface, not the backbone's skill; its cells are not a competent-PPO result (docs/backbones.md, PPO).")
-gb = [f"{bb} {cells[(bb, t, 'grammar_belief')][0] / cells[(bb, t, 'grammar_belief')][1]:.3f} ({t})"
-      for t in tasks for bb, _ in BACKBONES if (bb, t, "grammar_belief") in cells]
-print("- The grammar belief (its reference operating point: no pulse probes, hold probes, no pool), per backbone:")
-print("  " + ", ".join(gb) + "; compare each with the same backbone's oracle and pool methods above.\n")
-print("## The paper, for comparison\n")
-print(PAPER + "\n")
-print("## Backbone identities\n")
-print("| backbone | task | sha256 |")
-print("|---|---|---|")
-for (bb, task), h in sorted(sha.items()):
-    print(f"| `{bb}` | {task} | `{h}` |")
+if __name__ == "__main__":
+    main()

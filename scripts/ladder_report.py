@@ -114,8 +114,8 @@ specs = {}
 for key, expdir, method, _, _ in ROWS:
     specs.update(load_specs(expdir))
     for r in load(expdir):
-        if r["method"] != method:
-            continue
+        if r["method"] != method or "calibrated" in r.get("method_variant", ""):
+            continue  # the {calibrated} probe rule is not a row of this (not yet compare-based) page
         data.setdefault((key, r["task"], r["split"]), {})[(r["seed"], r["contract_index"], r["episode_index"])] = r
 tool = {}  # the identity-rotation tool cell (v1)
 tool_v2 = {}  # the identity-rotation tool cell (v2, the operating point)

@@ -1,190 +1,92 @@
 #!/usr/bin/env python3
-"""Writes docs/results/long_lag.md from the records of scripts/long_lag: success_once of the frozen reactive
-backbones (expert, mlp) and of the delay-aware ones (expert-delay-aware, mlp-delay-aware) on the long-lag
-splits, through oracle-encode and the exact belief, pooled over the seeds, with the ratio delay-aware /
-reactive (the paper's Table 4), the paired difference (bootstrap over episodes paired by seed and episode
-index: the same initial state and contract), and the lag-4 contracts on their own (from the split manifest).
-Standard library only.
-usage: scripts/long_lag_report.py RESULTS_DIR ACTIONSHIFT_BINARY WALL_SECONDS THREADS [CPU] > docs/results/long_lag.md
-(CPU: the `times` line of the runs, e.g. "2m19.630s 0m10.540s")"""
-import glob, json, math, os, random, subprocess, sys
-from collections import defaultdict
-
-results, binary, wall, threads = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
-CPU = sys.argv[5] if len(sys.argv) > 5 else ""
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-# the paper's Table 4 (delay-aware augmented-state PPO vs the frozen reactive PPO, 3 seeds, 600 episodes)
-PAPER = {("pick_cube", "oracle"): (0.528, 0.027), ("push_cube", "oracle"): (0.415, 0.153),
-         ("pick_cube", "exact_belief"): (0.360, 0.022), ("push_cube", "exact_belief"): (0.387, 0.117)}
-PAIRS = [("expert", "expert-delay-aware"), ("mlp", "mlp-delay-aware"), ("ppo", "ppo-delay-aware")]
-METHOD_NAME = {"oracle": "oracle-encode", "exact_belief": "exact-belief"}
-
+"""Writes docs/results/long_lag.md: the frozen reactive backbones (expert, mlp, ppo) against the delay-aware
+ones on the long-lag splits, through oracle-encode and the exact belief (the paper's Table 4). Layout only:
+every rate, interval and per-seed rate is from `actionshift compare` on the records; the paper's Table 4
+numbers from compare's paper fields (delay-aware backbones) and configs/paper/numbers.json by id (ratios,
+lag 4); nothing is typed here.
+usage: scripts/long_lag_report.py COMPARE_JSON RESULTS_DIR [--commit C --command CMD --wall S --cores N --cpu TIMES]"""
+import os
+import re
+import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report_util import cpu_text  # noqa: E402
+from pages import fmt, load_comparison, paper, provenance, table  # noqa: E402
+from pages.rest_util import commit_of, cpu_text, parser, rel, scalar  # noqa: E402
 
-
-def wilson(k, n, z=1.959963984540054):
-    if n == 0:
-        return (float("nan"),) * 3
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return p, max(0.0, c - h), min(1.0, c + h)
-
-
-def lags_of(split):
-    m = json.load(open(os.path.join(ROOT, "manifests", split + ".json")))
-    return [c["contract"]["lag"] for c in m["test"]]
-
-
-LAGS = {s: lags_of(s) for s in ("long_lag", "reference_long_lag")}
-# cell (task, split, method, backbone) -> {(seed, episode_index): (success, lag)}
-cells = defaultdict(dict)
-specs = []
-for path in sorted(glob.glob(os.path.join(results, "*.summary.json"))):
-    s = json.load(open(path))
-    if not s.get("complete"):
-        continue
-    specs.append(s["job"])
-    with open(path.replace(".summary.json", ".jsonl")) as f:
-        for line in f:
-            r = json.loads(line)
-            lag = LAGS[r["split"]][r["contract_index"]]
-            cells[(r["task"], r["split"], r["method"], r["backbone"])][(r["seed"], r["episode_index"])] = (r["success_once"], lag)
-
-
-def rate(cell, lag=None):
-    v = [s for s, l in cell.values() if lag is None or l == lag]
-    return wilson(sum(v), len(v)) + (len(v),)
-
-
-def per_seed(cell):
-    by = defaultdict(list)
-    for (seed, _), (s, _) in cell.items():
-        by[seed].append(s)
-    return " / ".join(f"{sum(v) / len(v):.3f}" for _, v in sorted(by.items()))
-
-
-def paired_diff(a, b, reps=2000):
-    keys = sorted(set(a) & set(b))
-    if not keys:
-        return None
-    d = [int(b[k][0]) - int(a[k][0]) for k in keys]
-    rng = random.Random(20260718)
-    boots = sorted(sum(d[rng.randrange(len(d))] for _ in d) / len(d) for _ in range(reps))
-    return sum(d) / len(d), boots[int(0.025 * reps)], boots[int(0.975 * reps) - 1]
-
-
-def fmt(w):
-    return "—" if w[3] == 0 else f"{w[0]:.3f} [{w[1]:.3f}, {w[2]:.3f}]"
+PAIRS = [("expert", "expert-delay-aware"), ("mlp", "mlp-delay-aware"), ("ppo", "ppo-delay-aware")]
+METHOD_NAME = {"oracle": "oracle-encode", "exact_belief": "exact belief"}
+SPLITS = ["reference_long_lag", "long_lag"]
 
 
 def ratio(num, den):
-    if num[3] == 0 or den[3] == 0:
-        return "—"
-    if den[0] == 0:
-        return "∞ (reactive 0)" if num[0] > 0 else "— (both 0)"
-    return f"{num[0] / den[0]:.1f}×"
+    """The ratio of two point estimates compare printed (the paper's Table 4 reports ratios)."""
+    if not num or not den:
+        return fmt.DASH
+    a, b = num["success_once"]["rate"], den["success_once"]["rate"]
+    if b == 0:
+        return "— (reactive 0)"
+    return f"{a / b:.1f}×"
 
 
-profiles = sorted({s.get("profile", "?") for s in specs})
-seeds = sorted({s["seed"] for s in specs})
-eps = sorted({s["episodes"] for s in specs})
-total = sum(len(c) for c in cells.values())
-print("# Long lag: delay-aware backbones against the frozen reactive ones\n")
-print(f"Generated by `scripts/long_lag_report.py` from `{results}` at commit `{commit}` (do not edit by hand).\n")
-print("The long-lag splits add a pipeline delay of 2 or 4 control steps to a contract. Re-encoding the action")
-print("(the oracle) or identifying the contract (the exact belief) cannot undo a delay: a reactive backbone acts on a")
-print("state its action reaches only L steps later. The paper's answer (§5.7, Table 4) is a new backbone that is")
-print("delay-aware, composed with the same adapters. Here the delay-aware backbones are the ones this project")
-print("ships (docs/backbones.md): `expert-delay-aware` (the scripted expert with a lag estimate and a Smith")
-print("predictor over its own actions), `mlp-delay-aware` (an MLP with the last four canonical actions appended to")
-print("its input, DAgger-trained under a lag drawn from {0, 1, 2, 4}) and `ppo-delay-aware` (`train ppo --delay-aware`:")
-print("the paper's own recipe, an augmented-state PPO with observation + last four executed canonical actions, trained")
-print("under a lag drawn from {0, 1, 2, 4}). Their reactive counterparts are `expert`, `mlp` and `ppo`. The paper's")
-print("'frozen ref' column is its reactive PPO, so the `ppo` rows are the like-for-like comparison.\n")
-print(f"- Command: `THREADS={threads} EPISODES={','.join(map(str, eps))} scripts/long_lag {results}`; {len(specs)} jobs, {total:,} episodes;"
-      f" wall time {int(float(wall))} s on {threads} thread(s) of a shared {os.cpu_count()}-core machine (load average {os.getloadavg()[1]:.1f} over the last 5 minutes at the end){cpu_text(CPU)}.")
-print(f"- Simulator profile **{', '.join(profiles)}** (docs/sim.md); seeds {', '.join(map(str, seeds))};"
-      f" {', '.join(map(str, eps))} episodes per (task, split, backbone, method, seed), dealt round-robin over the split's contracts.")
-print("- Splits: `reference_long_lag` (the paper's two long-lag contracts, lags 2 and 4; exact belief over the")
-print("  `reference9` pool) and `long_lag` (32 generated contracts, lags 2 and 4; exact belief over the 180-contract")
-print("  `full` pool). Success is success_once with its Wilson 95 % interval over all seeds; 'paired diff' is")
-print("  delay-aware − reactive over the same (seed, episode) pairs (same initial state and contract), with a bootstrap")
-print("  95 % interval over those pairs.")
-print("- Paper columns: the paper's Table 4 (3 seeds, 600 episodes, on its two long-lag contracts, i.e. our")
-print("  `reference_long_lag`): the delay-aware PPO, the frozen reactive PPO and their ratio.\n")
-for split in ("reference_long_lag", "long_lag"):
-    print(f"## {split}\n")
-    print("| task | method | reactive | success (Wilson 95 %) | delay-aware | success (Wilson 95 %) | ratio | paired diff [95 %] | paper delay-aware | paper frozen ref | paper ratio |")
-    print("|---|---|---|---|---|---|---:|---|---:|---:|---:|")
-    for task in ("pick_cube", "push_cube"):
-        for method in ("oracle", "exact_belief"):
-            for rb, db in PAIRS:
-                a, b = cells.get((task, split, method, rb), {}), cells.get((task, split, method, db), {})
-                if not a and not b:
-                    continue  # a pair this run did not have (no ppo weights for the task)
-                ra, rd = rate(a), rate(b)
-                d = paired_diff(a, b)
-                ds = "—" if d is None else f"{d[0]:+.3f} [{d[1]:+.3f}, {d[2]:+.3f}]"
-                p = PAPER.get((task, method)) if split == "reference_long_lag" else None
-                pc = ("—", "—", "—") if p is None else (f"{p[0]:.3f}", f"{p[1]:.3f}", f"{p[0] / p[1]:.1f}×")
-                print(f"| {task} | {METHOD_NAME[method]} | `{rb}` | {fmt(ra)} | `{db}` | {fmt(rd)} | {ratio(rd, ra)} | {ds} | {pc[0]} | {pc[1]} | {pc[2]} |")
-    print()
-# notes computed from the cells above
-ref = lambda t, m, b: rate(cells.get((t, "reference_long_lag", m, b), {}))
-print("## Reading\n")
-for task, m in (("pick_cube", "oracle"), ("push_cube", "oracle"), ("pick_cube", "exact_belief"), ("push_cube", "exact_belief")):
-    p = PAPER[(task, m)]
-    e, ed, ml, md = ref(task, m, "expert"), ref(task, m, "expert-delay-aware"), ref(task, m, "mlp"), ref(task, m, "mlp-delay-aware")
-    pp, pd = ref(task, m, "ppo"), ref(task, m, "ppo-delay-aware")
-    if min(e[3], ed[3], ml[3], md[3]) == 0:
-        continue
-    ppo_text = "" if min(pp[3], pd[3]) == 0 else f"; delay-aware PPO {pd[0]:.3f} against reactive PPO {pp[0]:.3f}"
-    print(f"- {task}, {METHOD_NAME[m]} on the paper's contracts: delay-aware expert {ed[0]:.3f}, delay-aware MLP {md[0]:.3f}"
-          f" (paper's delay-aware PPO {p[0]:.3f}); reactive expert {e[0]:.3f}, reactive MLP {ml[0]:.3f} (paper's frozen PPO {p[1]:.3f})"
-          f"{ppo_text}.")
-print("- A ratio over a reactive rate of a few successes in several hundred episodes is dominated by that count (one more")
-print("  success halves or doubles it); the paired difference with its interval is the stable comparison, and the")
-print("  delay-aware success rates themselves are what compares with the paper's delay-aware column.")
-for task in ("pick_cube", "push_cube"):
-    a_, b_ = cells.get((task, "reference_long_lag", "exact_belief", "ppo"), {}), cells.get((task, "reference_long_lag", "exact_belief", "ppo-delay-aware"), {})
-    o_ = cells.get((task, "reference_long_lag", "oracle", "ppo-delay-aware"), {})
-    d = paired_diff(a_, b_)
-    if d is not None and o_ and d[2] < 0:
-        print(f"- {task}: the delay-aware PPO solves the long lag through oracle-encode ({rate(o_)[0]:.3f}) but not through the passive"
-              f" exact belief ({rate(b_)[0]:.3f}, below the reactive PPO's {rate(a_)[0]:.3f}: {d[0]:+.3f} [{d[1]:+.3f}, {d[2]:+.3f}]),"
-              " where the paper's delay-aware PPO keeps most of its gain (0.387 against 0.415). The delay-aware expert and MLP keep")
-        print("  theirs. The same collapse shows without any lag (docs/backbones.md, delay-aware PPO), as it does for the")
-        print("  reference implementation's delay-aware PPO on Push/seen (its write-up: oracle 0.990, exact belief 0.370, probing")
-        print("  0.02-0.05). The cause, measured by scripts/belief_trace.py (docs/results/belief_trace.md, a diagnostic): not a")
-        print("  slower identification (the belief is right as early as for the reactive PPO), and only in small part the history")
-        print("  mismatch (feeding the network the executed actions recovers about 0.15 of a 0.59 drop on Push/seen); one")
-        print("  unencoded pose step at the episode's start under the oracle reproduces the collapse (0.85 to 0.27, the reactive")
-        print("  PPO 1.00 to 0.91), and four unencoded steps take it from 0.96 to about 0.23 on long_lag whatever its history:")
-        print("  the delay-aware PPO does not recover from the state a few off-policy steps leave, where the reactive one does.")
-print("- The delay-aware MLP is trained by DAgger from the delay-aware expert (an imitation student, not the paper's PPO);")
-print("  where it sits below its teacher, that gap is the student's (docs/results/gate0.md has its lag-free Gate 0).\n")
-print("## Lag 4 on its own\n")
-print("The same records restricted to the contracts with lag 4 (the paper: lag 4 stays hardest, 0.30-0.40 with")
-print("oracle-encode on the delay-aware PPO). Lag 2 is the rest of each split.\n")
-print("| split | task | method | backbone | lag 4: success (Wilson 95 %) | episodes | lag 2: success | episodes |")
-print("|---|---|---|---|---|---:|---|---:|")
-for split in ("reference_long_lag", "long_lag"):
-    for task in ("pick_cube", "push_cube"):
-        for method in ("oracle", "exact_belief"):
-            for rb, db in PAIRS:
-                for bb in (rb, db):
-                    c = cells.get((task, split, method, bb), {})
-                    if not c:
+def main():
+    ap = parser(__doc__)
+    ap.add_argument("compare")
+    ap.add_argument("results")
+    a = ap.parse_args()
+    C = load_comparison(a.compare)
+    numbers = paper.load_numbers()
+    res = rel(a.results)
+    specs = provenance.job_specs([a.results], C.jobs())
+    out = [provenance.header(
+        "Long lag: delay-aware backbones against the frozen reactive ones", "scripts/long_lag_report.py",
+        a.command or f"scripts/long_lag {res}", commit_of(a), [res], provenance.spec_values(specs, "profile"),
+        C.seeds(), C.episodes(), jobs=len(C.jobs()), episodes_per_seed=C.episodes_per_seed(), wall=a.wall,
+        cores=a.cores, paper_source=C.paper_source(),
+        extra=[f"CPU: {cpu_text(a.cpu)[2:] or 'not measured'}."])]
+    w = out.append
+    w("The long-lag splits add a pipeline delay of 2 or 4 control steps to a contract. Re-encoding the action (the\n"
+      "oracle) or identifying the contract (the exact belief) cannot undo a delay: a reactive backbone acts on a state\n"
+      "its action reaches only L steps later. The paper's answer (§5.7, Table 4) is a delay-aware backbone composed with\n"
+      "the same adapters. Ours (docs/backbones.md): `expert-delay-aware` (the scripted expert with a lag estimate and a\n"
+      "Smith predictor), `mlp-delay-aware` (DAgger MLP with the last four canonical actions as input) and\n"
+      "`ppo-delay-aware` (`train ppo --delay-aware`, the paper's recipe); their reactive counterparts `expert`, `mlp`,\n"
+      "`ppo`. Splits: `reference_long_lag` (the paper's two long-lag contracts, exact belief over `reference9`) and\n"
+      "`long_lag` (32 generated contracts, exact belief over `full`).\n")
+    w("Paper columns: compare sets the paper's Table 4 delay-aware PPO beside our delay-aware backbones and its frozen\n"
+      "reactive PPO (Table 2 / Table 5) beside our reactive ones, on `reference_long_lag` only. `ratio` is delay-aware /\n"
+      "reactive of the two point estimates in the row; the paper's ratio is its printed Table 4 ratio.\n")
+    for split in SPLITS:
+        if not C.cells_where(split=split):
+            continue
+        w(f"## {split}\n")
+        rows = []
+        for task in C.values("task"):
+            for method in ("oracle", "exact_belief"):
+                for rb, db in PAIRS:
+                    r, d = C.cell(task, split, method, rb), C.cell(task, split, method, db)
+                    if not r and not d:
                         continue
-                    r4, r2 = rate(c, 4), rate(c, 2)
-                    print(f"| {split} | {task} | {METHOD_NAME[method]} | `{bb}` | {fmt(r4)} | {r4[3]} | {fmt(r2)} | {r2[3]} |")
-print("\n## Per seed\n")
-print("| split | task | method | backbone | per-seed success (" + " / ".join(map(str, seeds)) + ") |")
-print("|---|---|---|---|---|")
-for (task, split, method, bb), c in sorted(cells.items(), key=lambda kv: (kv[0][1], kv[0][0], kv[0][2], kv[0][3])):
-    print(f"| {split} | {task} | {METHOD_NAME.get(method, method)} | `{bb}` | {per_seed(c)} |")
+                    pr = scalar(numbers, f"table4.{task}.{split}.{method}.ratio", 1) if split == "reference_long_lag" else fmt.DASH
+                    rows.append([task, METHOD_NAME[method], f"`{rb}`", fmt.cell_rate(r), paper.cell_column(r),
+                                 f"`{db}`", fmt.cell_rate(d), paper.cell_column(d), ratio(d, r), pr])
+        w(table.markdown(["task", "method", "reactive", "success (Wilson 95 %)", "paper frozen PPO", "delay-aware",
+                          "success (Wilson 95 %)", "paper delay-aware PPO", "ratio", "paper ratio"], rows,
+                         ["l", "l", "l", "l", "l", "l", "l", "l", "r", "l"]))
+    w("## The paper's findings\n")
+    rows = [["delay-aware beats reactive on the long lag (Table 4)",
+             "**untestable here**: the difference is between two backbones on the same episodes, and compare pairs "
+             "method labels within one backbone only (no cross-backbone paired difference); the rates are in the tables above"],
+            [f"lag 4 stays hardest, {scalar(numbers, 's5.7.lag4.oracle.success_once_lag4_min', 2)}–"
+             f"{scalar(numbers, 's5.7.lag4.oracle.success_once_lag4_max', 2)} with oracle-encode",
+             "**untestable here**: compare has no per-contract (per-lag) cells"]]
+    w(table.markdown(["finding", "status"], rows))
+    w("## Per seed\n")
+    rows = [[c["split"], c["task"], METHOD_NAME.get(c["method"], c["method"]), f"`{c['backbone']}`", fmt.per_seed(c),
+             fmt.probe_steps(c), fmt.safety(c)] for c in C.cells]
+    w(table.markdown(["split", "task", "method", "backbone", f"per-seed success ({' / '.join(map(str, C.seeds()))})",
+                      "probe steps", "flagged episodes"], rows))
+    print(re.sub(r"\n{3,}", "\n\n", "\n".join(out)).rstrip("\n"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Regenerates the golden-test fixtures under tests/pages/data/ (small result files from tiny jobs:
+# one seed, 4 episodes per job). Run only when the record format changes; then regenerate the golden
+# pages with `tests/pages/run_page_test.py PAGE ACTIONSHIFT --update`.
+# usage: tests/pages/make_fixtures.sh ACTIONSHIFT_BINARY [PAGE...]   (default: every page)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+AS="$(realpath "$1")"; shift
+PAGES="${*:-brittleness long_lag noise_sensitivity gate0 identifiers dualabi_pilot ladder}"
+D=tests/pages/data
+S=20260718
+N=4
+run() { "$AS" run --seed "${SEED:-$S}" --episodes "$N" --threads 1 --progress off "$@" > /dev/null; }
+for page in $PAGES; do
+  rm -rf "${D:?}/$page"; mkdir -p "$D/$page"
+  case $page in
+  brittleness)
+    mkdir -p "$D/$page/results/clean"
+    "$AS" gate0 --backbone expert --task pick_cube --episodes "$N" --seed "$S" --threads 1 --quiet \
+        --out "$D/$page/results/clean/expert.pick_cube.$S.json" > /dev/null || true
+    for m in no_adapt oracle grammar_belief; do run --task pick_cube --split reference_seen --method "$m" --out "$D/$page/results"; done
+    for m in entropy_probes 'entropy_probes{calibrated}' dualabi 'dualabi{calibrated}'; do
+      run --task pick_cube --split reference_seen --method "$m" --pool reference9 --out "$D/$page/results"
+    done ;;
+  long_lag)
+    for b in expert expert-delay-aware; do
+      run --task pick_cube --split reference_long_lag --method oracle --backbone "$b" --out "$D/$page/results"
+      run --task pick_cube --split reference_long_lag --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
+    done ;;
+  noise_sensitivity)
+    for mm in 0 20; do
+      d="$D/$page/results/sigma_${mm}mm"; mkdir -p "$d/matched"
+      sigma=$(python3 -c "print($mm / 1000)")
+      "$AS" calibrate --task pick_cube --obs-noise "$sigma" --out "$d/calibration.json" > /dev/null
+      for m in oracle no_adapt; do run --task pick_cube --split reference_seen --method "$m" --obs-noise "$sigma" --out "$d/matched"; done
+      for m in exact_belief entropy_probes 'entropy_probes{calibrated}' dualabi 'dualabi{calibrated}'; do
+        if [ "$mm" = 0 ]; then
+          run --task pick_cube --split reference_seen --method "$m" --pool reference9 --out "$d/matched"
+        else
+          run --task pick_cube --split reference_seen --method "$m" --pool reference9 --obs-noise "$sigma" --calibration "$d/calibration.json" --out "$d/matched"
+          run --task pick_cube --split reference_seen --method "$m" --pool reference9 --obs-noise "$sigma" --out "$d/noiseless_cal"
+        fi
+      done
+    done ;;
+  gate0)
+    mkdir -p "$D/$page/verdicts"
+    "$AS" gate0 --backbone expert --task pick_cube --episodes "$N" --threads 1 --quiet --out "$D/$page/verdicts/expert.pick_cube.json" > /dev/null || true
+    "$AS" gate0 --backbone mlp --task push_cube --episodes "$N" --threads 1 --quiet --out "$D/$page/verdicts/mlp.push_cube.json" > /dev/null || true ;;
+  identifiers)
+    mkdir -p "$D/$page/results/train" "$D/$page/results/eval"
+    for kind in osi probe_osi recurrent_osi; do
+      "$AS" train identifier --kind "$kind" --task pick_cube --seed 20260721 --episodes 1 --train-steps 20 --max-contracts 4 \
+          --threads 1 --quiet --out /tmp/pages_fixture.$kind.asid --verdicts "$D/$page/results/train/$kind.s20260721.json" > /dev/null
+    done
+    "$AS" train identifier --kind osi --excitation random --task pick_cube --seed 20260721 --episodes 1 --train-steps 20 --max-contracts 4 \
+        --threads 1 --quiet --out /tmp/pages_fixture.osi_random.asid --verdicts "$D/$page/results/train/osi_random.s20260721.json" > /dev/null
+    rm -f /tmp/pages_fixture.*.asid
+    for m in oracle no_adapt osi probe_osi recurrent_osi; do run --task pick_cube --split reference_seen --method "$m" --out "$D/$page/results/eval"; done ;;
+  dualabi_pilot)
+    for split_pool in "reference_seen reference9" "seen full"; do
+      set -- $split_pool
+      for m in entropy_probes 'dualabi{tau=0.4}' 'dualabi{tau=1.5}' 'dualabi{tau=10}'; do
+        SEED=20260723 run --task pick_cube --split "$1" --method "$m" --pool "$2" --out "$D/$page/results"
+      done
+    done ;;
+  ladder)
+    for name in pool_reference9 pool_full grammar_passive grammar_fixed grammar_hold v2_hold_corrector control_probe_only tool_identity_hold gen_hold; do
+      mkdir -p "$D/$page/results/$name"
+      exp="$D/$page/results/$name/experiment.yaml"
+      sed -e "s/^episodes: .*/episodes: $N/" -e "s/^seeds: .*/seeds: [$S]/" -e 's/^tasks: .*/tasks: [push_cube]/' \
+          "configs/experiments/ladder/$name.yaml" > "$exp"
+      case $name in gen_*) ;; *) sed -i -e 's/^splits: .*/splits: [reference_unseen_composition]/' "$exp" ;; esac
+      "$AS" plan --experiment "$exp" --out "$D/$page/results/$name" > /dev/null
+      "$AS" run --plan "$D/$page/results/$name/ladder_$name.plan.json" --out "$D/$page/results/$name" --threads 1 --progress off > /dev/null
+      rm -f "$D/$page/results/$name/"*.plan.json "$exp"
+    done ;;
+  esac
+  echo "$page: $(du -sk "$D/$page" | cut -f1) KB"
+done
