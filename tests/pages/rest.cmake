@@ -1,12 +1,18 @@
-# Golden tests of the long-lag, brittleness, noise-sensitivity, Gate 0, identifiers and DualABI-pilot
+# Golden tests of the long-lag, brittleness, noise-sensitivity, Gate 0, identifiers, DualABI-pilot and ladder
 # pages (included by tests/pages/CMakeLists.txt): each runs `actionshift compare` on a committed fixture and the
-# page script, and compares with tests/pages/golden/<page>.md. (The ladder page is not yet
-# compare-based: its fixture is in tests/pages/data/ladder/, its test to come.)
+# page script, and compares with tests/pages/golden/<page>.md (the ladder: one compare per group of
+# scripts/ladder_groups.py, pairs from the fixture's ladder*.pairs).
 find_package(Python3 COMPONENTS Interpreter)
 if(Python3_Interpreter_FOUND)
-  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot)
+  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder)
     add_test(NAME pages.${page}
              COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/run_page_test.py ${page} $<TARGET_FILE:actionshift>)
     set_tests_properties(pages.${page} PROPERTIES LABELS pages TIMEOUT 120)
   endforeach()
+endif()
+if(Python3_Interpreter_FOUND)
+  # the ladder page's per-contract path, on compare JSONs given a hand-made per_contract field
+  add_test(NAME pages.ladder_per_contract
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/ladder_per_contract_test.py $<TARGET_FILE:actionshift>)
+  set_tests_properties(pages.ladder_per_contract PROPERTIES LABELS pages TIMEOUT 120)
 endif()
