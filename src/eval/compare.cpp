@@ -206,7 +206,36 @@ std::string key_text(const PairKey& k) {
 
 // the summary owns the rule that names a record's cell (its method label): deriving the key through
 
-json cell_json(const CellSummary& c, const PaperNumbers& paper) {
+std::string cell_text(const CellKey& k) { return k.task + "/" + k.split + "/" + k.method + "/" + k.backbone; }
+
+// per contract index: its hash, episodes and success_once count; one hash per index
+json per_contract_json(const CellKey& key, const std::vector<EpisodeRecord>& records) {
+  struct Count {
+    std::string sha;
+    std::int64_t episodes{0}, successes{0};
+  };
+  std::map<std::int64_t, Count> by_index;
+  for (const auto& r : records) {
+    auto [it, fresh] = by_index.try_emplace(r.contract_index, Count{r.contract_sha256});
+    if (!fresh && it->second.sha != r.contract_sha256)
+      throw InputError("results", cell_text(key),
+                       "contract index " + std::to_string(r.contract_index) + " carries two contract hashes (" +
+                           it->second.sha.substr(0, 12) + " and " + r.contract_sha256.substr(0, 12) +
+                           "): records of different split definitions in one cell");
+    ++it->second.episodes;
+    it->second.successes += r.success_once ? 1 : 0;
+  }
+  json out = json::array();
+  for (const auto& [index, c] : by_index)
+    out.push_back({{"contract_index", index},
+                   {"contract_sha256", c.sha},
+                   {"episodes", c.episodes},
+                   {"successes", c.successes},
+                   {"success_once", wilson_json(wilson_interval(c.successes, c.episodes))}});
+  return out;
+}
+
+json cell_json(const CellSummary& c, const std::vector<EpisodeRecord>& records, const PaperNumbers& paper) {
   const double n = static_cast<double>(c.episodes);
   json seeds = json::array();
   for (const auto& s : c.per_seed)
@@ -233,6 +262,7 @@ json cell_json(const CellSummary& c, const PaperNumbers& paper) {
           {"success_once", wilson_json(c.success_once)},
           {"success_at_end_rate", c.success_at_end_rate},
           {"per_seed", seeds},
+          {"per_contract", per_contract_json(c.key, records)},
           {"mean_probe_steps", c.mean_probe_steps},
           {"mean_probe_displacement", c.mean_probe_displacement},
           {"safety",
@@ -251,9 +281,11 @@ std::string deciding_rule(const PromotionVerdict& v) {
   return v.safety_regression ? "safety_regression" : "no_five_point_gain_or_pareto_point";
 }
 
-json comparison_json(const ComparisonPair& pair, const CellKey& ck,
+json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKey& bk,
                      const std::vector<EpisodeRecord>& cand, const std::vector<EpisodeRecord>& base, const PaperNumbers& paper) {
-  const std::string cell = ck.task + "/" + ck.split + "/" + ck.backbone + ": " + pair.candidate + " vs " + pair.baseline;
+  const bool cross = pair.cross_backbone();
+  const std::string cname = pair.candidate_side(), bname = pair.baseline_side();
+  const std::string cell = ck.task + "/" + ck.split + (cross ? "" : "/" + ck.backbone) + ": " + cname + " vs " + bname;
   // pair exactly: the same (seed, contract, episode) on both sides, the same contract behind each
   std::map<PairKey, const EpisodeRecord*> c, b;
   for (const auto& r : cand) c.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
@@ -270,8 +302,8 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck,
     if (!c.count(k)) note_missing(k, only_b);
   if (only_c || only_b)
     throw InputError("results", cell,
-                     "the two cells hold different episodes: " + std::to_string(only_c) + " only in " + pair.candidate + ", " +
-                         std::to_string(only_b) + " only in " + pair.baseline + " (first " + key_text(*first) +
+                     "the two cells hold different episodes: " + std::to_string(only_c) + " only in " + cname + ", " +
+                         std::to_string(only_b) + " only in " + bname + " (first " + key_text(*first) +
                          "); run both on the same seeds and episode counts, or finish the incomplete job");
   std::vector<bool> cs, bs;
   std::map<std::uint64_t, std::tuple<std::int64_t, std::int64_t, std::int64_t>> per_seed;  // seed → (pairs, cand, base)
@@ -303,13 +335,16 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck,
   json paper_j = nullptr, agreement = nullptr;
   std::string agreement_reason;
   bool reversed = false;
-  const PaperNumber* p = (pair.candidate.find('{') == std::string::npos && pair.baseline.find('{') == std::string::npos)
+  const bool suffixed = pair.candidate.find('{') != std::string::npos || pair.baseline.find('{') != std::string::npos;
+  // a difference entry pairs two methods on one backbone: none is matched to a cross-backbone pair
+  const PaperNumber* p = (!suffixed && !cross)
                              ? find_paper_difference(paper, ck.task, ck.split, pair.candidate, pair.baseline, ck.backbone, &reversed)
                              : nullptr;
   if (p == nullptr) {
-    agreement_reason = pair.candidate.find('{') != std::string::npos || pair.baseline.find('{') != std::string::npos
-                           ? "a label with a {...} suffix is not the paper's method"
-                           : "the paper has no difference for this pair in this cell";
+    agreement_reason = suffixed ? "a label with a {...} suffix is not the paper's method"
+                       : cross  ? "the paper has no difference between these two backbones in this cell (Table 4 prints "
+                                  "ratios, no paired difference with an interval)"
+                                : "the paper has no difference for this pair in this cell";
   } else {
     const double sign = reversed ? -1.0 : 1.0;
     json iv = nullptr;
@@ -343,7 +378,9 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck,
           {"baseline", pair.baseline},
           {"task", ck.task},
           {"split", ck.split},
-          {"backbone", ck.backbone},
+          {"backbone", cross ? json(nullptr) : json(ck.backbone)},
+          {"candidate_backbone", ck.backbone},
+          {"baseline_backbone", bk.backbone},
           {"pairs", cs.size()},
           {"seeds", per_seed.size()},
           {"candidate_success", v.candidate_rate},
@@ -378,6 +415,28 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck,
 
 std::string method_base_name(std::string_view label) { return std::string(label.substr(0, label.find('{'))); }
 
+std::string ComparisonPair::candidate_side() const {
+  return candidate_backbone.empty() ? candidate : candidate + "@" + candidate_backbone;
+}
+std::string ComparisonPair::baseline_side() const {
+  return baseline_backbone.empty() ? baseline : baseline + "@" + baseline_backbone;
+}
+std::string ComparisonPair::text() const { return candidate_side() + " vs " + baseline_side(); }
+
+namespace {
+// `LABEL` or `LABEL@BACKBONE`: the first '@' outside the label's {...} separates
+std::pair<std::string, std::string> split_side(std::string_view side) {
+  int depth = 0;
+  for (std::size_t i = 0; i < side.size(); ++i) {
+    if (side[i] == '{') ++depth;
+    else if (side[i] == '}') depth = std::max(0, depth - 1);
+    else if (side[i] == '@' && depth == 0)
+      return {std::string(trim(side.substr(0, i))), std::string(trim(side.substr(i + 1)))};
+  }
+  return {std::string(side), {}};
+}
+}  // namespace
+
 ComparisonPair parse_comparison_pair(std::string_view text, const std::string& source, const std::string& field) {
   static constexpr std::string_view kSep = " vs ";
   const std::size_t at = text.find(kSep);
@@ -385,10 +444,21 @@ ComparisonPair parse_comparison_pair(std::string_view text, const std::string& s
     throw InputError(source, field, "expected 'CANDIDATE vs BASELINE' (got " + quote_input(text) + ")");
   if (text.find(kSep, at + 1) != std::string_view::npos)
     throw InputError(source, field, "more than one ' vs ' in " + quote_input(text));
-  ComparisonPair p{std::string(trim(text.substr(0, at))), std::string(trim(text.substr(at + kSep.size())))};
+  const std::string_view cand = trim(text.substr(0, at)), base = trim(text.substr(at + kSep.size()));
+  ComparisonPair p;
+  std::tie(p.candidate, p.candidate_backbone) = split_side(cand);
+  std::tie(p.baseline, p.baseline_backbone) = split_side(base);
   if (p.candidate.empty() || p.baseline.empty())
     throw InputError(source, field, "empty method label in " + quote_input(text));
-  if (p.candidate == p.baseline) throw InputError(source, field, "the candidate and the baseline are the same label " + quote_input(p.candidate));
+  const bool c_at = split_side(cand).first.size() != cand.size(), b_at = split_side(base).first.size() != base.size();
+  if (c_at != b_at)
+    throw InputError(source, field, "name a backbone on both sides ('LABEL@BACKBONE vs LABEL@BACKBONE') or on neither (got " +
+                                        quote_input(text) + ")");
+  if (c_at && (p.candidate_backbone.empty() || p.baseline_backbone.empty()))
+    throw InputError(source, field, "empty backbone after '@' in " + quote_input(text));
+  if (p.candidate == p.baseline && p.candidate_backbone == p.baseline_backbone)
+    throw InputError(source, field, "the candidate and the baseline are the same " + std::string(c_at ? "cell " : "label ") +
+                                        quote_input(p.candidate_side()));
   return p;
 }
 
@@ -479,10 +549,9 @@ const PaperNumber* find_paper_difference(const PaperNumbers& paper, std::string_
 json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
                      const PaperNumbers& paper, const CompareInputs& inputs) {
   {
-    std::set<std::pair<std::string, std::string>> seen;
+    std::set<std::string> seen;
     for (const auto& p : pairs)
-      if (!seen.emplace(p.candidate, p.baseline).second)
-        throw InputError("compare", "pair '" + p.candidate + " vs " + p.baseline + "'", "given twice");
+      if (!seen.insert(p.text()).second) throw InputError("compare", "pair '" + p.text() + "'", "given twice");
   }
   const std::vector<CellSummary> cells = summarize_records(records);
   std::map<CellKey, std::vector<EpisodeRecord>> by_cell;
@@ -500,19 +569,43 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
               {"cells", json::array()},
               {"pairs", json::array()},
               {"comparisons", json::array()}};
-  for (const auto& c : cells) out["cells"].push_back(cell_json(c, paper));
+  for (const auto& c : cells) out["cells"].push_back(cell_json(c, by_cell.at(c.key), paper));
 
   // (task, split, backbone) → label → cell key
   std::map<std::tuple<std::string, std::string, std::string>, std::map<std::string, CellKey>> groups;
-  std::set<std::string> labels;
+  std::set<std::string> labels, label_backbones;
+  std::set<std::pair<std::string, std::string>> task_splits;
   for (const auto& c : cells) {
     groups[{c.key.task, c.key.split, c.key.backbone}][c.key.method] = c.key;
     labels.insert(c.key.method);
+    label_backbones.insert(c.key.method + "@" + c.key.backbone);
+    task_splits.emplace(c.key.task, c.key.split);
   }
   for (const auto& pair : pairs) {
     json one_sided = json::array();
     std::size_t compared = 0;
+    if (pair.cross_backbone()) {
+      for (const auto& [task, split] : task_splits) {
+        const CellKey ck{task, split, pair.candidate, pair.candidate_backbone}, bk{task, split, pair.baseline, pair.baseline_backbone};
+        const bool has_c = by_cell.count(ck) > 0, has_b = by_cell.count(bk) > 0;
+        if (!has_c && !has_b) continue;
+        if (!has_c || !has_b) {
+          one_sided.push_back({{"task", task}, {"split", split}, {"backbone", has_c ? ck.backbone : bk.backbone},
+                               {"present", has_c ? pair.candidate_side() : pair.baseline_side()}});
+          continue;
+        }
+        out["comparisons"].push_back(comparison_json(pair, ck, bk, by_cell.at(ck), by_cell.at(bk), paper));
+        ++compared;
+      }
+      if (compared == 0) {
+        std::string present;
+        for (const auto& l : label_backbones) present += (present.empty() ? "" : ", ") + l;
+        throw InputError("compare", "pair '" + pair.text() + "'",
+                         "no (task, split) holds both cells (cells in the results: " + present + ")");
+      }
+    }
     for (const auto& [g, by_label] : groups) {
+      if (pair.cross_backbone()) break;
       const auto ci = by_label.find(pair.candidate), bi = by_label.find(pair.baseline);
       if (ci == by_label.end() && bi == by_label.end()) continue;
       const auto& [task, split, backbone] = g;
@@ -522,10 +615,10 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
         continue;
       }
       out["comparisons"].push_back(
-          comparison_json(pair, ci->second, by_cell.at(ci->second), by_cell.at(bi->second), paper));
+          comparison_json(pair, ci->second, bi->second, by_cell.at(ci->second), by_cell.at(bi->second), paper));
       ++compared;
     }
-    if (compared == 0) {
+    if (compared == 0 && !pair.cross_backbone()) {
       std::string present;
       for (const auto& l : labels) present += (present.empty() ? "" : ", ") + l;
       throw InputError("compare", "pair '" + pair.candidate + " vs " + pair.baseline + "'",
@@ -533,6 +626,8 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
     }
     out["pairs"].push_back({{"candidate", pair.candidate},
                             {"baseline", pair.baseline},
+                            {"candidate_backbone", pair.cross_backbone() ? json(pair.candidate_backbone) : json(nullptr)},
+                            {"baseline_backbone", pair.cross_backbone() ? json(pair.baseline_backbone) : json(nullptr)},
                             {"cells_compared", compared},
                             {"cells_with_one_side", one_sided}});
   }

@@ -53,6 +53,61 @@ assert p["matched_seeds"] == 1 and p["verdict"] in ("extend_seeds", "prune") and
 assert p["rule"] == {"extend_seeds": "fewer_than_three_matched_seeds", "prune": "one_seed_below_prune_floor"}[p["verdict"]]
 PY
 
+# a pair across backbones: the same method on two backbones (tiny real runs), paired on the same
+# (seed, contract index, episode index); per-contract cells agree with the records
+for b in expert mlp; do
+  run "$AS" run "${common[@]}" --method oracle --backbone "$b" --out "$TMP/x"
+  expect_rc 0 "run oracle on $b"
+done
+run "$AS" compare "$TMP/x" --pair 'oracle@mlp vs oracle@expert'
+expect_rc 0 "compare across backbones"
+printf '%s\n' "$OUT" >"$TMP/cross.json"
+python3 - "$TMP/cross.json" "$TMP/x" <<'PY' && ok || bad "cross-backbone compare JSON disagrees with the records"
+import glob, json, sys
+from statistics import mean
+j = json.load(open(sys.argv[1]))
+recs = [json.loads(l) for f in sorted(glob.glob(sys.argv[2] + "/*.jsonl")) for l in open(f) if l.strip()]
+by = {}
+for r in recs:
+    by.setdefault(r["backbone"], {})[(r["seed"], r["contract_index"], r["episode_index"])] = r
+assert set(by) == {"expert", "mlp"} and sorted(by["mlp"]) == sorted(by["expert"]) and len(by["mlp"]) == 4
+for k in by["mlp"]:
+    assert by["mlp"][k]["contract_sha256"] == by["expert"][k]["contract_sha256"], k
+(d,) = j["comparisons"]
+assert (d["candidate"], d["baseline"], d["candidate_backbone"], d["baseline_backbone"]) == ("oracle", "oracle", "mlp", "expert"), d
+assert d["backbone"] is None and d["pairs"] == 4 and d["paper"] is None and d["sign_agreement"] is None, d
+est = mean(by["mlp"][k]["success_once"] - by["expert"][k]["success_once"] for k in by["mlp"])
+assert abs(d["difference"]["estimate"] - est) < 1e-12, (d["difference"], est)
+(p,) = j["pairs"]
+assert (p["candidate_backbone"], p["baseline_backbone"], p["cells_compared"]) == ("mlp", "expert", 1), p
+for c in j["cells"]:
+    rs = [r for r in by[c["backbone"]].values()]
+    want = {}
+    for r in rs:
+        e = want.setdefault(r["contract_index"], [r["contract_sha256"], 0, 0])
+        e[1] += 1
+        e[2] += r["success_once"]
+    got = [(x["contract_index"], x["contract_sha256"], x["episodes"], x["successes"], x["success_once"]["successes"],
+            x["success_once"]["total"]) for x in c["per_contract"]]
+    assert got == [(i, s, n, k, k, n) for i, (s, n, k) in sorted(want.items())], (got, want)
+PY
+run "$AS" compare "$TMP/x" --pair 'oracle@mlp vs oracle'
+expect_rc 2 "a backbone on one side only"
+expect_one_line_error "a backbone on one side only"
+expect_err "name a backbone on both sides" "a backbone on one side only"
+run "$AS" compare "$TMP/x" --pair 'oracle@mlp vs oracle@ppo'
+expect_rc 2 "cross-backbone pair with an absent cell"
+expect_err "no (task, split) holds both cells (cells in the results: oracle@expert, oracle@mlp)" "absent cell lists the cells present"
+mkdir -p "$TMP/xm"
+cp "$TMP"/x/*.jsonl "$TMP"/x/*.summary.json "$TMP/xm/"
+short=$(grep -l '"backbone":"mlp"' "$TMP"/xm/*.jsonl)
+head -n 3 "$short" >"$short.tmp" && mv "$short.tmp" "$short"
+run "$AS" compare "$TMP/xm" --pair 'oracle@mlp vs oracle@expert'
+expect_rc 2 "mismatched cross-backbone pairing"
+expect_one_line_error "mismatched cross-backbone pairing"
+expect_err "pick_cube/reference_seen: oracle@mlp vs oracle@expert: the two cells hold different episodes: 0 only in oracle@mlp, 1 only in oracle@expert" \
+  "mismatched cross-backbone pairing names both cells"
+
 # --out and --pairs-from give the same document
 printf '# pairs\noracle vs no_adapt\n' >"$TMP/pairs.txt"
 run "$AS" compare "$TMP/r" --pairs-from "$TMP/pairs.txt" --out "$TMP/sub/out.json"

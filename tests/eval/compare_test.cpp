@@ -132,7 +132,92 @@ TEST(Compare, BackboneSpecificPaperNumberWinsOverTheGeneralOne) {
   EXPECT_EQ(find_cell(j, "entropy_probes", "expert-delay-aware")["paper"]["success_once"]["id"], "t4.entropy.delay");
 }
 
+TEST(Compare, CellsCarryPerContractCountsAndWilsonIntervals) {
+  // 2 contracts (index k % 2), 10 episodes per seed over 3 seeds: contract 0 succeeds at k = 0, 2, 4 (3 of 5
+  // per seed), contract 1 at every odd k (5 of 5)
+  const auto recs = cell("oracle", 10, [](int k) { return k % 2 == 1 || k < 6; });
+  const json j = compare_records(recs, {}, paper());
+  const json& pc = find_cell(j, "oracle")["per_contract"];
+  ASSERT_EQ(pc.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const std::int64_t k = i == 0 ? 9 : 15;
+    EXPECT_EQ(pc[i]["contract_index"], i);
+    EXPECT_EQ(pc[i]["contract_sha256"], recs[static_cast<std::size_t>(i)].contract_sha256);
+    EXPECT_EQ(pc[i]["episodes"], 15);
+    EXPECT_EQ(pc[i]["successes"], k);
+    EXPECT_EQ(pc[i]["success_once"], wilson_json(wilson_interval(k, 15)));
+    EXPECT_EQ(pc[i].size(), 5u);
+  }
+  EXPECT_NEAR(pc[0]["success_once"]["lower"].get<double>(), 0.3575, 5e-4);  // Wilson 95 % of 9/15
+  EXPECT_NEAR(pc[0]["success_once"]["upper"].get<double>(), 0.8018, 5e-4);
+  // one contract index with two hashes in a cell: an error naming the cell
+  auto bad = recs;
+  bad[2].contract_sha256 = std::string(64, 'b');
+  EXPECT_THAT([&] { compare_records(bad, {}, paper()); },
+              ThrowsMessage<InputError>(HasSubstr("pick_cube/reference_seen/oracle/expert: contract index 0 carries two contract hashes")));
+}
+
 // ---- pairs
+
+TEST(Compare, CrossBackbonePairIsThePairedDifferenceOnTheSameEpisodes) {
+  std::mt19937 rng(11);
+  std::bernoulli_distribution pc(0.6), pb(0.2);
+  const auto delay = cell("exact_belief", 40, [&](int) { return pc(rng); }, kSeeds, "ppo-delay-aware");
+  const auto reactive = cell("exact_belief", 40, [&](int) { return pb(rng); }, kSeeds, "ppo");
+  const auto other = cell("oracle", 40, [](int) { return true; }, kSeeds, "ppo");  // not part of the pair
+  std::map<PairKey, std::pair<bool, bool>> by_key;
+  for (const auto& r : delay) by_key[{r.seed, r.contract_index, r.episode_index}].first = r.success_once;
+  for (const auto& r : reactive) by_key[{r.seed, r.contract_index, r.episode_index}].second = r.success_once;
+  std::vector<bool> c, b;
+  for (const auto& [k, v] : by_key) {
+    c.push_back(v.first);
+    b.push_back(v.second);
+  }
+  const BootstrapInterval expected = paired_success_difference(c, b, 0.95, kBootstrapSamples, kBootstrapSeed);
+  const auto pair = parse_comparison_pair("exact_belief@ppo-delay-aware vs exact_belief@ppo", "--pair", "");
+  const json j = compare_records(concat(concat(reactive, other), delay), {pair}, paper());
+  ASSERT_EQ(j["comparisons"].size(), 1u);
+  const json& d = j["comparisons"][0];
+  EXPECT_EQ(d["candidate"], "exact_belief");
+  EXPECT_EQ(d["baseline"], "exact_belief");
+  EXPECT_EQ(d["candidate_backbone"], "ppo-delay-aware");
+  EXPECT_EQ(d["baseline_backbone"], "ppo");
+  EXPECT_TRUE(d["backbone"].is_null());
+  EXPECT_EQ(d["pairs"], 120);
+  EXPECT_EQ(d["seeds"], 3);
+  EXPECT_DOUBLE_EQ(d["difference"]["estimate"].get<double>(), expected.estimate);
+  EXPECT_DOUBLE_EQ(d["difference"]["lower"].get<double>(), expected.lower);
+  EXPECT_DOUBLE_EQ(d["difference"]["upper"].get<double>(), expected.upper);
+  EXPECT_TRUE(d["paper"].is_null());
+  EXPECT_THAT(d["sign_agreement_reason"].get<std::string>(), HasSubstr("between these two backbones"));
+  EXPECT_EQ(d["promotion"]["verdict"], promotion_verdict(delay, reactive).decision);
+  ASSERT_EQ(j["pairs"].size(), 1u);
+  EXPECT_EQ(j["pairs"][0]["candidate_backbone"], "ppo-delay-aware");
+  EXPECT_EQ(j["pairs"][0]["baseline_backbone"], "ppo");
+  EXPECT_EQ(j["pairs"][0]["cells_compared"], 1);
+  // a same-backbone pair names no backbones in its pair entry and its backbone in each comparison
+  const json k = compare_records(concat(reactive, other), {{"oracle", "exact_belief"}}, paper());
+  EXPECT_TRUE(k["pairs"][0]["candidate_backbone"].is_null());
+  EXPECT_EQ(k["comparisons"][0]["backbone"], "ppo");
+  EXPECT_EQ(k["comparisons"][0]["candidate_backbone"], "ppo");
+  EXPECT_EQ(k["comparisons"][0]["baseline_backbone"], "ppo");
+}
+
+TEST(Compare, CrossBackbonePairOverDifferentEpisodesIsAnErrorNamingBothCells) {
+  const auto delay = cell("exact_belief", 10, [](int) { return true; }, kSeeds, "ppo-delay-aware");
+  const auto reactive = cell("exact_belief", 9, [](int) { return false; }, kSeeds, "ppo");
+  const auto pair = parse_comparison_pair("exact_belief@ppo-delay-aware vs exact_belief@ppo", "--pair", "");
+  EXPECT_THAT([&] { compare_records(concat(delay, reactive), {pair}, paper()); },
+              ThrowsMessage<InputError>(HasSubstr("pick_cube/reference_seen: exact_belief@ppo-delay-aware vs exact_belief@ppo: the two "
+                                                  "cells hold different episodes: 3 only in exact_belief@ppo-delay-aware, 0 only in "
+                                                  "exact_belief@ppo")));
+  // no (task, split) holds both cells: an error listing the cells present
+  EXPECT_THAT([&] { compare_records(delay, {pair}, paper()); },
+              ThrowsMessage<InputError>(HasSubstr("pair 'exact_belief@ppo-delay-aware vs exact_belief@ppo': no (task, split) holds "
+                                                  "both cells (cells in the results: exact_belief@ppo-delay-aware)")));
+  const json j = compare_records(concat(delay, cell("exact_belief", 10, [](int) { return true; }, kSeeds, "ppo")), {pair}, paper());
+  EXPECT_EQ(j["comparisons"][0]["difference"]["estimate"], 0.0);
+}
 
 TEST(Compare, PairedDifferenceIsTheLibrarysOnTheKeySortedPairs) {
   std::mt19937 rng(7);
@@ -183,7 +268,8 @@ TEST(Compare, CellsThatDoNotPairExactlyAreAnErrorNamingTheCell) {
               ThrowsMessage<InputError>(HasSubstr("pick_cube/reference_seen/expert: entropy_probes vs fixed_probes: the two cells hold "
                                                   "different episodes: 3 only in entropy_probes, 0 only in fixed_probes")));
   auto other = cell("fixed_probes", 10, [](int) { return true; });
-  other[4].contract_sha256 = std::string(64, 'a');
+  for (auto& r : other)  // a consistent cell whose contract 0 is another contract than the candidate's
+    if (r.contract_index == 0) r.contract_sha256 = std::string(64, 'a');
   EXPECT_THAT([&] { compare_records(concat(cand, other), {{"entropy_probes", "fixed_probes"}}, paper()); },
               ThrowsMessage<InputError>(HasSubstr("ran different contracts")));
   // a pair that no cell holds is an error naming the labels present, not an empty result
@@ -289,6 +375,27 @@ TEST(ComparePairs, LabelsWithBracesCommasAndEqualsSurvive) {
               ThrowsMessage<InputError>(HasSubstr("pairs.txt:2: pair: expected 'CANDIDATE vs BASELINE'")));
   EXPECT_THAT([] { compare_records(make_records("t", "s", "a", {1}, 2, [](int) { return true; }), {{"a", "b"}, {"a", "b"}}, PaperNumbers{}); },
               ThrowsMessage<InputError>(HasSubstr("given twice")));
+}
+
+TEST(ComparePairs, ASideMayNameABackboneAfterTheLabel) {
+  auto p = parse_comparison_pair("exact_belief@ppo-delay-aware vs exact_belief@ppo", "--pair", "");
+  EXPECT_EQ(p, (ComparisonPair{"exact_belief", "exact_belief", "ppo-delay-aware", "ppo"}));
+  EXPECT_TRUE(p.cross_backbone());
+  EXPECT_EQ(p.text(), "exact_belief@ppo-delay-aware vs exact_belief@ppo");
+  // an '@' inside the braces belongs to the label; the first '@' after them separates; a backbone may hold '@'
+  p = parse_comparison_pair("m{note=a@b} vs m", "--pair", "");
+  EXPECT_EQ(p, (ComparisonPair{"m{note=a@b}", "m"}));
+  EXPECT_FALSE(p.cross_backbone());
+  p = parse_comparison_pair("m{note=a@b}@mlp:/w/a@b.asmlp vs m@expert", "--pair", "");
+  EXPECT_EQ(p, (ComparisonPair{"m{note=a@b}", "m", "mlp:/w/a@b.asmlp", "expert"}));
+  EXPECT_THAT([] { parse_comparison_pair("a@x vs b", "--pair", ""); },
+              ThrowsMessage<InputError>(HasSubstr("name a backbone on both sides")));
+  EXPECT_THAT([] { parse_comparison_pair("a@x vs a@x", "--pair", ""); }, ThrowsMessage<InputError>(HasSubstr("the same cell")));
+  EXPECT_THROW(parse_comparison_pair("a@ vs a@x", "--pair", ""), InputError);
+  EXPECT_THROW(parse_comparison_pair("@x vs a@y", "--pair", ""), InputError);
+  EXPECT_NO_THROW(parse_comparison_pair("a@x vs b@x", "--pair", ""));
+  EXPECT_THAT([] { compare_records(make_records("t", "s", "a", {1}, 2, [](int) { return true; }), {{"a", "a", "x", "y"}, {"a", "a", "x", "y"}}, PaperNumbers{}); },
+              ThrowsMessage<InputError>(HasSubstr("pair 'a@x vs a@y': given twice")));
 }
 
 // ---- the paper-numbers file

@@ -26,7 +26,9 @@ for page in $PAGES; do
     for b in expert expert-delay-aware; do
       run --task pick_cube --split reference_long_lag --method oracle --backbone "$b" --out "$D/$page/results"
       run --task pick_cube --split reference_long_lag --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
-    done ;;
+    done
+    printf '%s\n' 'oracle@expert-delay-aware vs oracle@expert' 'exact_belief@expert-delay-aware vs exact_belief@expert' \
+        > "$D/$page/pairs.txt" ;;
   noise_sensitivity)
     for mm in 0 20; do
       d="$D/$page/results/sigma_${mm}mm"; mkdir -p "$d/matched"

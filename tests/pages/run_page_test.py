@@ -32,7 +32,7 @@ def page_text(page, binary, tmp):
         return py("scripts/brittleness_report.py", f"{tmp}/c.json", f"{d}/results", *PROV,
                   "--command", f"THREADS=1 EPISODES=4 scripts/brittleness {d}/results")
     if page == "long_lag":
-        compare(binary, [f"{d}/results"], f"{tmp}/c.json")
+        compare(binary, [f"{d}/results"], f"{tmp}/c.json", f"{d}/pairs.txt")
         return py("scripts/long_lag_report.py", f"{tmp}/c.json", f"{d}/results", *PROV,
                   "--command", f"THREADS=1 EPISODES=4 scripts/long_lag {d}/results")
     if page == "noise_sensitivity":

@@ -25,15 +25,26 @@ inline constexpr std::string_view kComparisonSchemaVersion = "1.0";
 inline constexpr std::string_view kPaperNumbersSchemaVersion = "1.0";
 
 /// A comparison of two method labels (opaque strings, e.g. `entropy_probes` or
-/// `entropy_probes{calibrated}`): candidate − baseline.
+/// `entropy_probes{calibrated}`): candidate − baseline. Without backbones both sides run on the same
+/// backbone (compared in every (task, split, backbone)); with them (`LABEL@BACKBONE` on both sides) the
+/// candidate's cell on one backbone is compared with the baseline's on another, in every (task, split).
 struct ComparisonPair {
   std::string candidate;
   std::string baseline;
+  std::string candidate_backbone{};  ///< non-empty only in a cross-backbone pair (then so is baseline_backbone)
+  std::string baseline_backbone{};
+  bool cross_backbone() const { return !candidate_backbone.empty(); }
+  std::string candidate_side() const;  ///< `LABEL` or `LABEL@BACKBONE`, as written
+  std::string baseline_side() const;
+  std::string text() const;  ///< `CANDIDATE vs BASELINE`, as written
   bool operator==(const ComparisonPair&) const = default;
 };
 
 /// Parse `CANDIDATE vs BASELINE` (exactly one " vs ", both sides non-empty and different; labels may
-/// hold `{`, `,`, `=`). Throws InputError(source, field, reason).
+/// hold `{`, `,`, `=`). A side may name a backbone, `LABEL@BACKBONE`: the first `@` outside the label's
+/// `{...}` separates (a method name holds no `@`; an `@` inside the braces, a parameter's text, is part
+/// of the label; a backbone name may hold `@`). Both sides name a backbone or neither. Throws
+/// InputError(source, field, reason).
 ComparisonPair parse_comparison_pair(std::string_view text, const std::string& source, const std::string& field);
 
 /// The pairs of a pairs file: one `CANDIDATE vs BASELINE` per line; blank lines and lines starting
@@ -96,12 +107,14 @@ struct CompareInputs {
   std::vector<Directory> directories;
 };
 
-/// The comparison of `records` (docs/formats.md "Comparison"). Cells are those of summarize_records;
-/// each pair is compared in every (task, split, backbone) holding both labels, with
+/// The comparison of `records` (docs/formats.md "Comparison"). Cells are those of summarize_records,
+/// each with its per-contract counts and Wilson intervals (an error naming the cell if one contract
+/// index carries two contract hashes); each same-backbone pair is compared in every (task, split,
+/// backbone) holding both labels, each cross-backbone pair in every (task, split) holding both cells, with
 /// paired_success_difference over the pairs sorted by PairKey (kBootstrapSamples resamples, seed
 /// kBootstrapSeed) and promotion_verdict. Throws InputError naming the cell if a pair's two cells do
 /// not hold the same episodes (seed, contract, episode index) or ran different contracts, and naming
-/// the pair if no (task, split, backbone) holds both labels.
+/// the pair if no (task, split, backbone) holds both labels (no (task, split) both cells).
 nlohmann::json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
                                const PaperNumbers& paper, const CompareInputs& inputs = {});
 
