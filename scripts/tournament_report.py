@@ -67,7 +67,7 @@ agg = [e for e in agg if e]
 if agg:
     out.append("\nThe paper's displacement is printed only as an aggregate over Pick/Push seen and unseen composition ("
                + agg[0]["source"] + "): " + ", ".join(f"{e['method']} {paper.entry_value(e)} m" for e in agg)
-               + "; the paper-numbers file has no per-cell displacement.\n")
+               + "; per-cell values are the reference implementation's (its DualABI-vs-entropy report).\n")
 
 # ---- displacement
 out.append("\n## Why entropy probes move the arm more than the paper's\n\n")
@@ -84,11 +84,10 @@ if cell["entropy_probes"] and cell["fixed_probes"]:
         f"{fmt.probe_steps(cell['fixed_probes'])} steps. "
         + ("The paper-numbers file has no per-cell displacement for this cell, so the paper's values cannot be set "
            "beside these from it" if not (pe or pf) else
-           f"The paper: entropy {paper.entry_value(pe)} m, fixed {paper.entry_value(pf)} m")
+           f"The paper's reference implementation: entropy {paper.entry_value(pe)} m, fixed {paper.entry_value(pf)} m")
         + ". Both of our rules choose probes that travel farther than fixed probes, so the difference between our "
         "entropy displacement and the paper's does not come from the `{calibrated}` changes (which alter which probe "
-        "is chosen, not how far a probe moves); where it does come from is being measured separately (below, when "
-        "available).\n\n")
+        "is chosen, not how far a probe moves); where it does come from is measured below.\n\n")
     out.append(table.markdown(["method", "probe steps", "displacement [m]", "paper displacement"],
                               [[f"`{m}`", fmt.probe_steps(x), fmt.displacement(x),
                                 paper.cell_column(x, "mean_probe_displacement", 4)] for m, x in cell.items() if x]))

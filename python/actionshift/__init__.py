@@ -250,13 +250,15 @@ def make_vec(task="pick_cube", num_envs=2, contract=None, split=None, index=0, p
                   profile=profile, threads=threads)
 
 
-def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None):
+def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, calibration=None):
     """An adapter by method name (``methods()``) or variant label (``"entropy_probes{calibrated}"``,
     ``method_variants()``; a bare name is the paper's method): ``begin_episode(seed)``, ``encode(canonical, R)``
     -> raw action, ``observe(raw, response, R)``. Belief methods use the task's built-in response
     calibration; pool methods need ``pool`` (a pool name such as ``"reference9"``, a manifest path,
-    or a list of contracts); the oracle needs ``truth``. ``params``: method parameters (dict)."""
-    return _native._make_adapter(method, task, pool, truth, params)
+    or a list of contracts); the oracle needs ``truth``. ``params``: method parameters (dict).
+    ``calibration``: a response calibration (a dict as ``actionshift calibrate --json`` writes it, or
+    its file) instead of the task's built-in one, for belief methods only."""
+    return _native._make_adapter(method, task, pool, truth, params, calibration)
 
 
 def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,

@@ -47,6 +47,7 @@
 #include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -875,7 +876,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
 
 // an adapter by method name, with its task's calibration and (for pool methods) a pool
 std::unique_ptr<adapt::Adapter> make_adapter(const std::string& label, const std::string& task, py::object pool,
-                                             py::object truth, py::object params) {
+                                             py::object truth, py::object params, py::object calibration) {
   (void)sim::parse_task(task);  // every method names a task, even those that do not read its calibration
   const std::string text =
       params.is_none() ? std::string("{}") : (py::isinstance<py::str>(params) ? params.cast<std::string>() : py_to_json(params, "params"));
@@ -898,8 +899,21 @@ std::unique_ptr<adapt::Adapter> make_adapter(const std::string& label, const std
     in.truth = &*h.truth;
   }
   if (adapt::method_needs_calibration(method)) {
-    h.model = eval::builtin_calibration(std::string(sim::task_name(sim::parse_task(task)))).model();
+    if (calibration.is_none()) {
+      h.model = eval::builtin_calibration(std::string(sim::task_name(sim::parse_task(task)))).model();
+    } else if (py::isinstance<py::dict>(calibration)) {  // a calibration object, as `calibrate --json` writes it
+      h.model = adapt::ResponseCalibration::from_json(py_to_json(calibration, "calibration"), "calibration").model();
+    } else {  // a calibration file
+      const std::string path = py::str(py::module_::import("os").attr("fspath")(calibration)).cast<std::string>();
+      std::ifstream f(path, std::ios::binary);
+      if (!f) throw InputError(path, "", "cannot read calibration file");
+      std::stringstream ss;
+      ss << f.rdbuf();
+      h.model = adapt::ResponseCalibration::from_json(ss.str(), path).model();
+    }
     in.model = &*h.model;
+  } else if (!calibration.is_none()) {
+    throw InputError("method " + method, "calibration", "this method uses no response calibration");
   }
   return adapt::make_adapter(method, p, in);  // adapters copy what they keep
 }
@@ -1257,7 +1271,7 @@ PYBIND11_MODULE(_native, m) {
       .def_property_readonly("last_probe", [](const adapt::Adapter& a) { return a.last_step().probe; })
       .def_property_readonly("last_task_regret", [](const adapt::Adapter& a) { return a.last_step().task_regret; });
   m.def("_make_adapter", &make_adapter, py::arg("method"), py::arg("task"), py::arg("pool"), py::arg("truth"),
-        py::arg("params"));
+        py::arg("params"), py::arg("calibration"));
   m.def("methods", &adapt::method_names);
   m.def("method_needs_pool", &adapt::method_needs_pool, py::arg("method"));
   m.def("method_needs_calibration", &adapt::method_needs_calibration, py::arg("method"));
