@@ -35,17 +35,20 @@ for n in names:
         if not isv2(n) and params.get("gripper_channel") is True:
             fail.append(f"{n}: a v1 experiment runs with the finger channel")
 page = open(os.path.join(out, "ladder.md")).read()
-for key in ("passive_v2", "fixed_v2", "hold_v2", "hold_corr_v2", "hold_r2_corr_v2"):
-    rows = [l for l in page.splitlines() if l.startswith(f"| {key} | v2")]
+# the split tables: one row per v2 experiment on each reference split, its label carrying the finger channel
+for exp in ("v2_passive", "v2_fixed", "v2_hold", "v2_hold_corrector", "v2_hold_r2_corrector"):
+    rows = [l for l in page.splitlines() if l.startswith("| `grammar_belief{") and f"| {exp} |" in l]
     if len(rows) != 2:
-        fail.append(f"page: {len(rows)} rows for {key} in the split tables, expected 2")
+        fail.append(f"page: {len(rows)} rows for {exp} in the split tables, expected 2")
     for l in rows:
-        pick = l.split("|")[4].strip()
-        if "(n=2)" not in pick:
-            fail.append(f"page: {key}: Pick cell '{pick}' (expected 2 episodes)")
-tool = [l for l in page.splitlines() if l.startswith("| v2 hold + corrector | Pick |")]
-if len(tool) != 2 or any("(n=1)" not in l.split("|")[4] or "(n=1)" not in l.split("|")[5] for l in tool):
-    fail.append(f"page: the v2 tool-frame rows for Pick are missing or empty: {tool}")
+        cols = [c.strip() for c in l.split("|")]
+        if "gripper_channel=true" not in cols[1]:
+            fail.append(f"page: {exp}: label {cols[1]} lacks the finger channel")
+        if not cols[7].endswith("/2"):
+            fail.append(f"page: {exp}: k/n '{cols[7]}' (expected 2 episodes)")
+tool = [l for l in page.splitlines() if l.startswith("| v2 operating point | `grammar_belief{gripper_channel=true")]
+if len(tool) != 1 or any("[" not in c for c in [x.strip() for x in tool[0].split("|")][4:6]):
+    fail.append(f"page: the v2 tool-frame row is missing or empty: {tool}")
 if "committed calibrations have no finger" in page:
     fail.append("page: still says the committed calibrations have no finger block")
 for f in fail:
