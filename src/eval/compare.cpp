@@ -281,6 +281,13 @@ std::string deciding_rule(const PromotionVerdict& v) {
   return v.safety_regression ? "safety_regression" : "no_five_point_gain_or_pareto_point";
 }
 
+// the verdict, the rule that decided it and its reason, then the fields every promotion JSON shares
+json promotion_json(const PromotionVerdict& v) {
+  json j = {{"verdict", v.decision}, {"rule", deciding_rule(v)}, {"reason", v.reason}};
+  j.update(promotion_rule_fields(v));
+  return j;
+}
+
 json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKey& bk,
                      const std::vector<EpisodeRecord>& cand, const std::vector<EpisodeRecord>& base, const PaperNumbers& paper) {
   const bool cross = pair.cross_backbone();
@@ -397,18 +404,7 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKe
           {"paper", paper_j},
           {"sign_agreement", agreement},
           {"sign_agreement_reason", agreement.is_null() ? json(agreement_reason) : json(nullptr)},
-          {"promotion",
-           {{"verdict", v.decision},
-            {"rule", deciding_rule(v)},
-            {"reason", v.reason},
-            {"matched_seeds", v.matched_seeds},
-            {"candidate_probe_steps", v.candidate_probe_steps},
-            {"baseline_probe_steps", v.baseline_probe_steps},
-            {"candidate_flag_rate", v.candidate_flag_rate},
-            {"baseline_flag_rate", v.baseline_flag_rate},
-            {"five_point_rule", v.five_point_rule},
-            {"pareto_rule", v.pareto_rule},
-            {"safety_regression", v.safety_regression}}}};
+          {"promotion", promotion_json(v)}};
 }
 
 }  // namespace

@@ -371,6 +371,17 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
 }
 
 
+json promotion_rule_fields(const PromotionVerdict& v) {
+  return {{"matched_seeds", v.matched_seeds},
+          {"candidate_probe_steps", v.candidate_probe_steps},
+          {"baseline_probe_steps", v.baseline_probe_steps},
+          {"candidate_flag_rate", v.candidate_flag_rate},
+          {"baseline_flag_rate", v.baseline_flag_rate},
+          {"five_point_rule", v.five_point_rule},
+          {"pareto_rule", v.pareto_rule},
+          {"safety_regression", v.safety_regression}};
+}
+
 json promotion_report(const std::vector<EpisodeRecord>& records, const std::string& candidate, const std::string& baseline,
                       std::size_t samples, std::uint64_t seed) {
   // group by (task, split, backbone); keep cells where both methods ran
@@ -407,18 +418,11 @@ json promotion_report(const std::vector<EpisodeRecord>& records, const std::stri
                        {"backbone", pair.first.front().backbone},
                        {"verdict", v.decision},
                        {"reason", v.reason},
-                       {"matched_seeds", v.matched_seeds},
                        {"episodes", static_cast<std::int64_t>(std::min(pair.first.size(), pair.second.size()))},
                        {"candidate_success", v.candidate_rate},
                        {"baseline_success", v.baseline_rate},
-                       {"difference", bootstrap_json(v.difference)},
-                       {"candidate_probe_steps", v.candidate_probe_steps},
-                       {"baseline_probe_steps", v.baseline_probe_steps},
-                       {"candidate_flag_rate", v.candidate_flag_rate},
-                       {"baseline_flag_rate", v.baseline_flag_rate},
-                       {"five_point_rule", v.five_point_rule},
-                       {"pareto_rule", v.pareto_rule},
-                       {"safety_regression", v.safety_regression}};
+                       {"difference", bootstrap_json(v.difference)}};
+    j["cells"][key].update(promotion_rule_fields(v));
   }
   return j;
 }

@@ -113,6 +113,10 @@ PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate,
                                    const std::vector<EpisodeRecord>& baseline,
                                    std::size_t samples = kBootstrapSamples, std::uint64_t seed = kBootstrapSeed);
 
+/// The fields every promotion JSON shares (a verdict file's cell, a comparison's `promotion`):
+/// matched_seeds, candidate/baseline probe steps and safety-flag rates, and the three rule flags.
+nlohmann::json promotion_rule_fields(const PromotionVerdict& v);
+
 /// Promotion verdicts of `candidate` against `baseline` for every (task, split, backbone) cell of
 /// `records` holding both methods: the verdict file {"gate":"promotion","candidate","baseline",
 /// "cells":{"<task>/<split>":{"verdict","reason",...evidence}}} (comparable with gate check).
