@@ -9,6 +9,7 @@
 #include "actionshift/sim/task.hpp"
 #include "commands.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -56,12 +57,26 @@ void check_obs_noise(double sigma) {
 
 }  // namespace
 
+// --seed-file: one decimal integer in [0, 2**64), surrounding whitespace allowed. The seed stays out of
+// the command line, which every process of the machine (an external policy too) can read.
+std::uint64_t read_seed_file(const std::string& path) {
+  const std::string text = read_input_file(path, "seed file", 4096);
+  const auto a = text.find_first_not_of(" \t\r\n");
+  const auto b = text.find_last_not_of(" \t\r\n");
+  const std::string s = a == std::string::npos ? std::string() : text.substr(a, b - a + 1);
+  const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (!digits || (s.size() == 20 && s > "18446744073709551615"))
+    throw InputError(path, "seed", "must hold one integer in [0, 2**64) (got " + quote_input(s) + ")");
+  return std::stoull(s);
+}
+
 void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options) {
   check_obs_noise(o.request.obs_noise);
   // syntax errors and repeated keys of --params are named as the option's (the resolver parses it again)
   (void)parse_json_input(o.method_params, "command line", "--params");
   eval::JobRequest q = o.request;
   q.method.params = o.method_params;
+  if (!o.seed_file.empty()) q.seed = read_seed_file(o.seed_file);
   job = eval::resolve_job(q, eval::default_resolver());
   job.robot = cli_robot_ref(o.robot);
   job.policy_files = cli_policy_files(o.policy_files, job.backbone.name);

@@ -24,6 +24,7 @@ struct CliJobOptions {
   RobotOptions robot;              // --robot/--package (single job; a plan carries its own)
   std::vector<std::string> policy_files;  // --policy-files: files of an external policy (content hashed into the id)
   std::string calibration;         // --calibration: response calibration file instead of the built-in one
+  std::string seed_file;           // --seed-file: the experimental seed read from a file (an evaluator's undisclosed seed)
 };
 // The job these options name, and the run-time options of its episode function (the calibration
 // file, read and checked against the job's task and profile). Throws actionshift::InputError.

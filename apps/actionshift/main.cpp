@@ -157,7 +157,11 @@ int main(int argc, char** argv) {
     }
     cmd->add_option("--params", j.method_params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
         ->capture_default_str();
-    cmd->add_option("--seed", j.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
+    auto* seed = cmd->add_option("--seed", j.request.seed, "Experimental seed")->check(kSeed)->capture_default_str();
+    cmd->add_option("--seed-file", j.seed_file,
+                    "Read the experimental seed from FILE (one integer) instead of --seed: an evaluator's undisclosed seed "
+                    "stays off the command line, which any process on the machine can read (docs/formats.md §1)")
+        ->excludes(seed);
     cmd->add_option("--episodes", j.request.episodes,
                     "Episodes, dealt in blocks over the split's contracts: each contract once per block, in a seeded order, "
                     "every contract of a block from the same initial state")

@@ -160,6 +160,18 @@ run "$AS" run --task pick_cube --split reference_seen --method 'entropy_probes{b
 expect_rc 2 "label and params disagree"
 expect_one_line_error "label and params disagree"
 
+# ---- an evaluator's undisclosed seed: --seed-file is the same job as --seed, off the command line
+echo 424242 > "$TMP/seed.txt"
+run "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 2 --seed-file "$TMP/seed.txt" --out "$TMP/sf" --progress off
+expect_rc 0 "run --seed-file"
+run "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 2 --seed 424242 --out "$TMP/sf" --progress off
+expect_out "already complete" "--seed-file names the job --seed names"
+echo "seven" > "$TMP/badseed.txt"
+run "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 2 --seed-file "$TMP/badseed.txt" --out "$TMP/sf" --progress off
+expect_rc 2 "malformed seed file"
+expect_one_line_error "malformed seed file"
+expect_err "badseed.txt: seed: must hold one integer" "malformed seed file message"
+
 # ---- bad input: one line, exit 2, nothing written over
 run "$AS" run --task pick_cube --split seen --method telepathy --out "$TMP/x" --progress off
 expect_rc 2 "unknown method"
