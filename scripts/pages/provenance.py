@@ -68,5 +68,9 @@ def header(title, script, command, commit, inputs, profiles, seeds, episodes, jo
     if paper_source:
         stats += f"; the paper's numbers from {paper_source.replace('built-in ', '')} (via compare)"
     lines.append(stats + ".")
+    lines.append("- Paired schedule (job schema 3.0): the split's contracts share each block's initial state, so a cell "
+                 "of N episodes over n contracts holds N/n initial states per seed. The intervals treat episodes as "
+                 "independent; where success depends on the initial state more than on the contract (an oracle, a "
+                 "split of many contracts and few blocks) they are narrower than the initial states justify.")
     lines += [f"- {x}" for x in extra]
     return "\n".join(lines) + "\n\n"
