@@ -72,6 +72,7 @@ struct CompareOptions {
   std::string pairs_file;                 ///< --pairs-from FILE: one 'CANDIDATE vs BASELINE' per line
   std::string paper_file;                 ///< --paper FILE ("" → the built-in configs/paper/numbers.json)
   std::string out_file;                   ///< --out FILE ("" → stdout)
+  bool common_episodes = false;           ///< --common-episodes: pair the episodes both cells hold
 };
 int run_compare(const CompareOptions& o);
 

@@ -570,6 +570,10 @@ int main(int argc, char** argv) {
   compare->add_option("--paper", cmp_o.paper_file,
                       "Paper-numbers file (default: configs/paper/numbers.json as compiled into this build)");
   compare->add_option("--out", cmp_o.out_file, "Write the JSON here (default: stdout)");
+  compare->add_flag("--common-episodes", cmp_o.common_episodes,
+                    "Pair only the episodes both cells of a pair hold (a 50-episode job with the first 50 of a\n"
+                    "200-episode one) instead of refusing cells whose episode sets differ; each comparison says in\n"
+                    "'unpaired' how many it left out. Check those counts: an unfinished job is left out silently otherwise");
   compare->callback([&] { action = [&] { return cli::run_compare(cmp_o); }; });
 
   cli::CalibrateOptions cal_o;

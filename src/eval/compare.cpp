@@ -289,14 +289,15 @@ json promotion_json(const PromotionVerdict& v) {
 }
 
 json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKey& bk,
-                     const std::vector<EpisodeRecord>& cand, const std::vector<EpisodeRecord>& base, const PaperNumbers& paper) {
+                     const std::vector<EpisodeRecord>& cand_all, const std::vector<EpisodeRecord>& base_all, const PaperNumbers& paper,
+                     bool common_episodes) {
   const bool cross = pair.cross_backbone();
   const std::string cname = pair.candidate_side(), bname = pair.baseline_side();
   const std::string cell = ck.task + "/" + ck.split + (cross ? "" : "/" + ck.backbone) + ": " + cname + " vs " + bname;
   // pair exactly: the same (seed, contract, episode) on both sides, the same contract behind each
   std::map<PairKey, const EpisodeRecord*> c, b;
-  for (const auto& r : cand) c.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
-  for (const auto& r : base) b.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
+  for (const auto& r : cand_all) c.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
+  for (const auto& r : base_all) b.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
   std::size_t only_c = 0, only_b = 0;
   std::optional<PairKey> first;
   const auto note_missing = [&](const PairKey& k, std::size_t& count) {
@@ -307,7 +308,19 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKe
     if (!b.count(k)) note_missing(k, only_c);
   for (const auto& [k, r] : b)
     if (!c.count(k)) note_missing(k, only_b);
-  if (only_c || only_b)
+  // --common-episodes: pair the episodes both cells hold (a job's first M episodes are the M-episode job's,
+  // so a 50-episode cell pairs with the first 50 of a 200-episode one); the output says how many were left out
+  std::vector<EpisodeRecord> cand, base;
+  for (const auto& r : cand_all)
+    if (!common_episodes || b.count(PairKey{r.seed, r.contract_index, r.episode_index})) cand.push_back(r);
+  for (const auto& r : base_all)
+    if (!common_episodes || c.count(PairKey{r.seed, r.contract_index, r.episode_index})) base.push_back(r);
+  if (common_episodes) {
+    std::erase_if(c, [&](const auto& e) { return !b.count(e.first); });
+    std::erase_if(b, [&](const auto& e) { return !c.count(e.first); });
+    if (c.empty()) throw InputError("results", cell, "the two cells hold no episode in common");
+  }
+  if (!common_episodes && (only_c || only_b))
     throw InputError("results", cell,
                      "the two cells hold different episodes: " + std::to_string(only_c) + " only in " + cname + ", " +
                          std::to_string(only_b) + " only in " + bname + " (first " + key_text(*first) +
@@ -389,6 +402,7 @@ json comparison_json(const ComparisonPair& pair, const CellKey& ck, const CellKe
           {"candidate_backbone", ck.backbone},
           {"baseline_backbone", bk.backbone},
           {"pairs", cs.size()},
+          {"unpaired", common_episodes ? json({{"candidate", only_c}, {"baseline", only_b}}) : json(nullptr)},
           {"seeds", per_seed.size()},
           {"candidate_success", v.candidate_rate},
           {"baseline_success", v.baseline_rate},
@@ -543,7 +557,7 @@ const PaperNumber* find_paper_difference(const PaperNumbers& paper, std::string_
 }
 
 json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
-                     const PaperNumbers& paper, const CompareInputs& inputs) {
+                     const PaperNumbers& paper, const CompareInputs& inputs, bool common_episodes) {
   {
     std::set<std::string> seen;
     for (const auto& p : pairs)
@@ -590,7 +604,7 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
                                {"present", has_c ? pair.candidate_side() : pair.baseline_side()}});
           continue;
         }
-        out["comparisons"].push_back(comparison_json(pair, ck, bk, by_cell.at(ck), by_cell.at(bk), paper));
+        out["comparisons"].push_back(comparison_json(pair, ck, bk, by_cell.at(ck), by_cell.at(bk), paper, common_episodes));
         ++compared;
       }
       if (compared == 0) {
@@ -611,7 +625,7 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
         continue;
       }
       out["comparisons"].push_back(
-          comparison_json(pair, ci->second, bi->second, by_cell.at(ci->second), by_cell.at(bi->second), paper));
+          comparison_json(pair, ci->second, bi->second, by_cell.at(ci->second), by_cell.at(bi->second), paper, common_episodes));
       ++compared;
     }
     if (compared == 0 && !pair.cross_backbone()) {
@@ -631,7 +645,7 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
 }
 
 json compare_directories(const std::vector<std::string>& dirs, const std::vector<ComparisonPair>& pairs,
-                         const PaperNumbers& paper) {
+                         const PaperNumbers& paper, bool common_episodes) {
   namespace fs = std::filesystem;
   if (dirs.empty()) throw InputError("compare", "RESULTS_DIR", "give at least one results directory");
   CompareInputs inputs;
@@ -649,7 +663,7 @@ json compare_directories(const std::vector<std::string>& dirs, const std::vector
     inputs.directories.push_back({d, rs.files, rs.records.size(), rs.notes});
     records.insert(records.end(), std::make_move_iterator(rs.records.begin()), std::make_move_iterator(rs.records.end()));
   }
-  return compare_records(records, pairs, paper, inputs);
+  return compare_records(records, pairs, paper, inputs, common_episodes);
 }
 
 }  // namespace actionshift::eval

@@ -172,4 +172,15 @@ expect_rc 2 "mismatched pairing"
 expect_one_line_error "mismatched pairing"
 expect_err "pick_cube/reference_seen/expert: oracle vs no_adapt: the two cells hold different episodes: 1 only in oracle" \
   "mismatched pairing names the cell"
+# ---- --common-episodes: a 4-episode job pairs with the first 4 episodes of an 8-episode one
+"$AS" run --task pick_cube --split reference_seen --method oracle --episodes 4 --out "$TMP/common" --progress off > /dev/null 2>&1
+"$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 8 --out "$TMP/common" --progress off > /dev/null 2>&1
+run "$AS" compare "$TMP/common" --pair 'oracle vs no_adapt'
+expect_rc 2 "cells with different episode sets are refused without --common-episodes"
+expect_err "hold different episodes" "the refusal names the difference"
+run "$AS" compare "$TMP/common" --pair 'oracle vs no_adapt' --common-episodes
+expect_rc 0 "compare --common-episodes"
+[ "$(echo "$OUT" | python3 -c 'import json,sys; c=json.load(sys.stdin)["comparisons"][0]; print(c["pairs"], c["unpaired"]["candidate"], c["unpaired"]["baseline"])')" = "4 0 4" ] \
+  && ok || bad "--common-episodes should pair 4 episodes and leave 4 of the baseline out"
+
 finish

@@ -16,8 +16,8 @@ DATA = "tests/pages/data"
 PROV = ["--commit", "0000000", "--wall", "12", "--cores", "2", "--cpu", "0m1.500s 0m0.500s"]
 
 
-def compare(binary, dirs, out, pairs=None):
-    cmd = [binary, "compare", *dirs, "--out", out] + (["--pairs-from", pairs] if pairs else [])
+def compare(binary, dirs, out, pairs=None, extra=()):
+    cmd = [binary, "compare", *dirs, "--out", out] + (["--pairs-from", pairs] if pairs else []) + list(extra)
     subprocess.run(cmd, check=True, cwd=ROOT)
 
 
@@ -65,7 +65,7 @@ def page_text(page, binary, tmp):
         from ladder_groups import groups  # noqa: E402
         for name, dirs, pairs in groups(os.path.join(ROOT, d, "results"), pairs_dir=os.path.join(ROOT, d)):
             compare(binary, [os.path.relpath(x, ROOT) for x in dirs], f"{cdir}/{name}.json",
-                    os.path.relpath(pairs, ROOT) if pairs else None)
+                    os.path.relpath(pairs, ROOT) if pairs else None, ["--common-episodes"])
         return py("scripts/ladder_report.py", f"{d}/results", cdir, *PROV, "--command", f"scripts/ladder {d}/results")
     raise SystemExit(f"run_page_test: unknown page {page}")
 

@@ -115,12 +115,15 @@ struct CompareInputs {
 /// kBootstrapSeed) and promotion_verdict. Throws InputError naming the cell if a pair's two cells do
 /// not hold the same episodes (seed, contract, episode index) or ran different contracts, and naming
 /// the pair if no (task, split, backbone) holds both labels (no (task, split) both cells).
+/// `common_episodes`: pair only the episodes both cells hold instead of refusing cells whose episode sets
+/// differ (a job's first M episodes are the M-episode job's, so a 50-episode cell pairs with the first 50
+/// of a 200-episode one); each comparison then says in `unpaired` how many episodes of each side it left out.
 nlohmann::json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
-                               const PaperNumbers& paper, const CompareInputs& inputs = {});
+                               const PaperNumbers& paper, const CompareInputs& inputs = {}, bool common_episodes = false);
 
 /// load_results of every directory, then compare_records. Throws InputError for a directory without
 /// records (naming it) and as compare_records.
 nlohmann::json compare_directories(const std::vector<std::string>& dirs, const std::vector<ComparisonPair>& pairs,
-                                   const PaperNumbers& paper);
+                                   const PaperNumbers& paper, bool common_episodes = false);
 
 }  // namespace actionshift::eval
