@@ -483,6 +483,20 @@ void require_slurm_plan(const Plan& plan, const SlurmOptions& o, const char* wha
   if (plan.jobs.empty()) throw std::invalid_argument(std::string(what) + ": the plan has no jobs");
   if (o.plan_path.empty()) throw std::invalid_argument(std::string(what) + ": plan_path is required");
   if (o.max_array_size == 0) throw std::invalid_argument(std::string(what) + ": max_array_size must be positive");
+  // #SBATCH lines are read by Slurm, not the shell: quoting cannot protect them, so a line break (or any
+  // control character) in a value written there would start a line of its own, run as a shell command
+  const auto one_line = [](const std::string& v, const char* field) {
+    for (char c : v)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        throw InputError("plan --slurm", field, "contains a control character (got " + quote_input(v) + "); it would break the #SBATCH lines");
+  };
+  one_line(o.out_dir, "--out");
+  one_line(o.executable, "executable");
+  one_line(o.plan_path, "plan path");
+  one_line(o.time_limit, "--time");
+  one_line(o.mem, "--mem");
+  one_line(o.partition, "--partition");
+  one_line(plan.experiment, "experiment name");
 }
 
 // The #SBATCH lines every script shares: time, memory, partition.

@@ -89,7 +89,10 @@ ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, co
   s.summary_path_ = (std::filesystem::path(out_dir) / summary_file_name(s.id_)).string();
 
   // open without truncation and take the job's lock before reading anything
-  s.fd_ = ::open(s.path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  // O_NOFOLLOW: a symbolic link at <id>.jsonl would make the job append to (and repair) a file outside --out
+  s.fd_ = ::open(s.path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (s.fd_ < 0 && errno == ELOOP)
+    throw InputError(s.path_, "", "is a symbolic link: a results file must be a regular file inside the results directory");
   if (s.fd_ < 0) throw InputError(s.path_, "", "cannot open results file: " + errno_text());
   struct stat st{};
   if (::fstat(s.fd_, &st) != 0 || !S_ISREG(st.st_mode))

@@ -167,7 +167,17 @@ mkdir -p "$TMP/rz"
 ln -s /dev/zero "$TMP/rz/$(basename "$JL")"
 run timeout 20 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/rz" --progress off
 expect_rc 2 "results file on /dev/zero"
-expect_err "not a regular file" "results file on /dev/zero"
+expect_err "is a symbolic link" "results file on /dev/zero"
+# a results file that links to a regular file elsewhere: refused, and the link's target is untouched
+mkdir -p "$TMP/rl"
+cp "$TMP/clean.jsonl" "$TMP/outside.jsonl"
+ln -s "$TMP/outside.jsonl" "$TMP/rl/$(basename "$JL")"
+sha_target=$(sha256sum < "$TMP/outside.jsonl")
+run timeout 20 "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/rl" --progress off
+expect_rc 2 "results file linked outside --out"
+expect_one_line_error "results file linked outside --out"
+expect_err "is a symbolic link" "results file linked outside --out"
+[ "$(sha256sum < "$TMP/outside.jsonl")" = "$sha_target" ] && ok || bad "a run through a symlinked results file changed its target"
 run timeout 20 "$AS" summarize "$TMP/r" --out "$TMP/fifo"
 expect_rc 2 "summarize --out a FIFO"
 expect_err "not a regular file (refusing to replace it)" "summarize --out a FIFO"
@@ -264,6 +274,16 @@ run "$AS" contract hash '{"frame":"base","gripper_inverted":false,"lag":0,"permu
 expect_rc 2 "contract with a repeated key"
 expect_one_line_error "contract with a repeated key"
 expect_err "lag: duplicate key in one object" "contract with a repeated key"
+# the duplicate-key check is one hash set per object: 200,000 distinct keys (2.6 MB) parse at once (each key
+# was compared with all before it: > 60 s), and a duplicate at the end is still found
+python3 -c 'import json; d={f"k{i:07d}": i for i in range(200000)}; print(json.dumps(d))' > "$TMP/manykeys.json"
+run timeout 20 "$AS" contract hash "$TMP/manykeys.json"
+expect_rc 2 "a 200,000-key object is parsed (within the timeout) and refused as a contract"
+expect_one_line_error "a 200,000-key object"
+python3 -c 'import json; d={f"k{i:07d}": i for i in range(200000)}; print(json.dumps(d)[:-1] + ", \"k0000007\": 1}")' > "$TMP/manykeys_dup.json"
+run timeout 20 "$AS" contract hash "$TMP/manykeys_dup.json"
+expect_rc 2 "a duplicate key after 200,000 keys"
+expect_err "k0000007: duplicate key in one object" "a duplicate key after 200,000 keys"
 run "$AS" run --task pick_cube --split reference_seen --method entropy_probes --pool reference9 \
   --params '{"budget":1,"budget":2}' --episodes 1 --out "$TMP/dupparams" --progress off
 expect_rc 2 "--params with a repeated key"

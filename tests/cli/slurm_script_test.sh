@@ -60,6 +60,12 @@ expect_rc 2 "missing --executable"
 expect_err "not found on PATH" "missing --executable message"
 run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad" --slurm --executable "$TMP/exp.yaml"
 expect_rc 2 "non-executable --executable"
+# a line break in a path would start a line of its own after "#SBATCH --output=" (run by the shell): refused
+run "$AS" plan --experiment "$TMP/exp.yaml" --out "$TMP/bad
+touch $TMP/injected" --slurm
+expect_rc 2 "--out with a line break"
+expect_one_line_error "--out with a line break"
+expect_err "contains a control character" "--out with a line break message"
 # none of the refused Slurm options left a file behind (the plan is checked before it is written)
 [ ! -e "$TMP/bad" ] && ok || bad "a refused Slurm option left files: $(ls -R "$TMP/bad" 2>&1)"
 finish

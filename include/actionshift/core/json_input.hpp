@@ -11,6 +11,7 @@
 
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 namespace actionshift {
@@ -67,7 +68,8 @@ inline nlohmann::json parse_json_input(std::string_view text, const std::string&
   if (!field.empty()) names.push_back(field);
   // the keys seen so far in each open object, innermost last: a repeated key is refused (nlohmann
   // would keep the last value silently, so `{"scale": 1, "scale": -1}` would read as -1)
-  std::vector<std::vector<std::string>> open_keys;
+  // (a hash set per object: a vector compared every key with all before it, quadratic in the key count)
+  std::vector<std::unordered_set<std::string>> open_keys;
   const std::size_t base = names.size();
   const auto at = [&](int depth) { return base + static_cast<std::size_t>(depth > 0 ? depth : 0); };
   const nlohmann::json::parser_callback_t track = [&](int depth, nlohmann::json::parse_event_t event,
@@ -88,11 +90,8 @@ inline nlohmann::json parse_json_input(std::string_view text, const std::string&
         names.resize(at(depth - 1));
         names.push_back(parsed.is_string() ? parsed.get<std::string>() : std::string("?"));
         if (!open_keys.empty() && parsed.is_string()) {
-          std::vector<std::string>& seen = open_keys.back();
-          const std::string& key = parsed.get_ref<const std::string&>();
-          for (const std::string& k : seen)
-            if (k == key) throw InputError(source, printable_input(detail::json_field_path(names), 200), "duplicate key in one object");
-          seen.push_back(key);
+          if (!open_keys.back().insert(parsed.get_ref<const std::string&>()).second)
+            throw InputError(source, printable_input(detail::json_field_path(names), 200), "duplicate key in one object");
         }
         break;
       }
