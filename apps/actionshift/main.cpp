@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->check(kProfile)->capture_default_str();
   bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
-  bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores)")
+  bench_env->add_option("--threads", bench_env_o.threads, "Threads for the all-threads figure (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   bench_env->add_flag("--json", bench_env_o.json, "Print one JSON object");
@@ -338,7 +338,7 @@ int main(int argc, char** argv) {
   bc->add_option("--iterations", train_o.iterations, "DAgger iterations (the first rolls out the expert)")->capture_default_str();
   bc->add_option("--episodes", train_o.episodes, "Episodes per iteration")->capture_default_str();
   bc->add_option("--steps", train_o.steps, "Adam steps per iteration")->capture_default_str();
-  bc->add_option("--threads", train_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
+  bc->add_option("--threads", train_o.threads, "Data-collection threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   bc->add_option("--hidden", train_o.hidden, "Hidden layer widths (tanh), comma-separated")->capture_default_str();
   bc->add_option("--out", train_o.out, "Weight file (default: configs/backbones/<task>.<backbone>.asmlp)");
   bc->add_option("--progress", train_o.progress, "auto, bar or lines (one line per iteration) or off, as for run")
@@ -363,7 +363,7 @@ int main(int argc, char** argv) {
   tid->add_option("--train-steps", tid_o.train_steps, "Adam steps")->capture_default_str();
   tid->add_option("--max-contracts", tid_o.max_contracts, "Use only the first N training and held-out contracts (smoke runs; 0: all)")
       ->capture_default_str();
-  tid->add_option("--threads", tid_o.threads, "Data-collection threads (0: all cores)")->capture_default_str();
+  tid->add_option("--threads", tid_o.threads, "Data-collection threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   tid->add_option("--out", tid_o.out, "Weight file (default: configs/identifiers/<task>.<kind>.asid)");
   tid->add_option("--verdicts", tid_o.verdicts, "Also write the held-out verdicts (field accuracy per horizon) as JSON here");
   tid->add_flag("--quiet", tid_o.quiet, "No progress lines");
@@ -392,7 +392,7 @@ int main(int argc, char** argv) {
   ppo->add_option("--hidden", ppo_o.hidden, "Hidden layer widths of actor and critic, comma separated")->capture_default_str();
   ppo->add_option("--eval-every", ppo_o.eval_every, "Iterations between deterministic evaluations (and checkpoints)")->capture_default_str();
   ppo->add_option("--eval-episodes", ppo_o.eval_episodes, "Episodes per evaluation (training seed stream)")->capture_default_str();
-  ppo->add_option("--threads", ppo_o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  ppo->add_option("--threads", ppo_o.threads, "Worker threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   ppo->add_option("--out", ppo_o.out, "Weight file (default: configs/backbones/<task>.ppo.asmlp)");
   ppo->add_option("--curve", ppo_o.curve, "Training curve, JSON lines (default: the weight file's name with .curve.jsonl)");
   ppo->add_flag("--delay-aware", ppo_o.delay_aware,
@@ -427,7 +427,7 @@ int main(int argc, char** argv) {
   gate0->add_option("--floor", gate0_o.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)")
       ->check(CLI::Range(0.0, 1.0) & kNotNan);
   gate0->add_option("--rule", gate0_o.rule, "Competence statistic: wilson_lower or point_estimate")->capture_default_str();
-  gate0->add_option("--threads", gate0_o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  gate0->add_option("--threads", gate0_o.threads, "Worker threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   gate0->add_flag("--json", gate0_o.json, "Print the verdict file instead of text");
   gate0->add_option("--out", gate0_o.out, "Write the verdict file here");
   gate0->add_option("--backbones-dir", gate0_o.backbones_dir, "Directory of the MLP weight files");
@@ -462,7 +462,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Validator(
           [](std::string& v) { return !v.empty() && v[0] == '-' ? "must be a job index >= 0 (got " + v + ")" : std::string(); }, ""));
   run->add_option("--out", run_o.run.out_dir, "Results directory")->capture_default_str();
-  run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores)")->capture_default_str();
+  run->add_option("--threads", run_o.run.threads, "Worker threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   run->add_flag("--fsync", run_o.run.fsync, "fsync after every record");
   run->add_option("--progress", run_o.run.progress, "auto, bar, lines or off")->capture_default_str();
   run->add_option("--step-timeout", run_o.run.step_timeout_s,
@@ -588,7 +588,7 @@ int main(int argc, char** argv) {
                         "wrapper does, 63 samples each), reference_walk (the same walks without the reset) or\n"
                         "episodes (task episodes with resets, capped at the horizon)")
       ->capture_default_str();
-  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (maniskill_walk, reference_walk) or episodes")->capture_default_str();
+  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (maniskill_walk, reference_walk) or episodes; 1 to 100000")->check(CLI::Range(1, 100000))->capture_default_str();
   calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode")->capture_default_str();
   calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
   calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");

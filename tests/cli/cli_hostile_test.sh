@@ -269,6 +269,16 @@ run "$AS" montage "$TMP/huge.gif" --out "$TMP/m.gif" --delay 0
 expect_rc 2 "montage delay 0"
 expect_err "--delay: must be in 1..1000" "montage delay 0"
 
+# ---- amplification: thread counts and calibration walks are bounded (10,000 threads made 7,939 OS threads)
+run "$AS" run --task pick_cube --split reference_seen --method oracle --threads 10000 --out "$TMP/th" --progress off
+expect_rc 2 "run --threads 10000"
+expect_one_line_error "run --threads 10000"
+expect_err "--threads: Value 10000 not in range 0 to 1024" "run --threads 10000 message"
+[ ! -e "$TMP/th" ] && ok || bad "a refused --threads left a results directory"
+run "$AS" calibrate --task pick_cube --episodes 2000000000
+expect_rc 2 "calibrate --episodes 2e9"
+expect_err "--episodes: Value 2000000000 not in range 1 to 100000" "calibrate --episodes 2e9 message"
+
 # ---- a repeated key: the second value used to win silently (JSON) or be ignored (YAML)
 run "$AS" contract hash '{"frame":"base","gripper_inverted":false,"lag":0,"permutation":[0,1,2,3,4,5],"scale":[1,1,1,1,1,1],"sign":[1,1,1,1,1,1],"target":"delta","lag":2}'
 expect_rc 2 "contract with a repeated key"
