@@ -1,6 +1,7 @@
 // Decode/encode throughput. Budgets (issue 2): decode+encode of one 7-vector <= 50 ns;
 // batched decode >= 20 million actions/s on one core.
 #include "actionshift/core/decoder.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/reference_contracts.hpp"
 #include "actionshift/core/transforms.hpp"
 
@@ -66,3 +67,15 @@ void BM_DecoderBatched(benchmark::State& state) {
 BENCHMARK(BM_DecoderBatched)->Args({1024, 0})->Args({1024, 2})->Args({16, 0});
 
 }  // namespace
+
+// parse_json_input on one object of N distinct keys: the duplicate-key check must stay linear in N
+// (it compared each key with every earlier one: 200,000 keys took over a minute)
+static void BM_ParseJsonManyKeys(benchmark::State& state) {
+  const auto n = static_cast<int>(state.range(0));
+  std::string text = "{";
+  for (int i = 0; i < n; ++i) text += (i ? ",\"k" : "\"k") + std::to_string(i) + "\":" + std::to_string(i);
+  text += "}";
+  for (auto _ : state) benchmark::DoNotOptimize(actionshift::parse_json_input(text, "bench"));
+  state.SetComplexityN(n);
+}
+BENCHMARK(BM_ParseJsonManyKeys)->RangeMultiplier(10)->Range(2000, 200000)->Unit(benchmark::kMillisecond)->Complexity();
