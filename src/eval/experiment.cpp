@@ -75,7 +75,23 @@ std::string canonical_method_label(const std::string& label) {
   return adapt::method_variant_label(m.name, adapt::resolve_method_params(m.name, parse_params(m.params, m.name)));
 }
 
+namespace {
+std::string method_variant_uncached(const JobSpec& job);
+}  // namespace
+
 std::string method_variant(const JobSpec& job) {
+  // called for every record a job writes or re-reads: remember the last job's label (per thread)
+  thread_local std::string last_method, last_params, last_label;
+  if (job.method != last_method || job.method_params != last_params || last_label.empty()) {
+    last_label = method_variant_uncached(job);
+    last_method = job.method;
+    last_params = job.method_params;
+  }
+  return last_label;
+}
+
+namespace {
+std::string method_variant_uncached(const JobSpec& job) {
   const auto& known = adapt::method_names();
   const nlohmann::json params = parse_params(job.method_params, job.method);
   if (std::find(known.begin(), known.end(), job.method) != known.end())
@@ -86,6 +102,7 @@ std::string method_variant(const JobSpec& job) {
     items += (items.empty() ? "" : ",") + it.key() + "=" + (it.value().is_string() ? it.value().get<std::string>() : canonical_dump(it.value()));
   return items.empty() ? job.method : job.method + "{" + items + "}";
 }
+}  // namespace
 
 PlanResolver default_resolver() {
   PlanResolver r;
