@@ -14,6 +14,7 @@ import sys as _sys
 
 import numpy as _np
 
+from . import _identity
 from . import _native
 from ._native import (  # noqa: F401  (re-exported API)
     Adapter,
@@ -22,6 +23,8 @@ from ._native import (  # noqa: F401  (re-exported API)
     InputError,
     MAX_NUM_ENVS,
     Manifest,
+    PoolBelief,
+    ResponseModel,
     SelfTest,
     builtin_manifests,
     decode,
@@ -31,6 +34,7 @@ from ._native import (  # noqa: F401  (re-exported API)
     method_needs_calibration,
     method_label,
     method_needs_pool,
+    method_rung,
     method_params,
     method_variants,
     methods,
@@ -46,6 +50,7 @@ __all__ = [
     "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
     "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
     "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
+    "method_rung", "PoolBelief", "ResponseModel",
     "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
 ]
 
@@ -263,9 +268,10 @@ def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, c
 
 def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,
              out="results", backbone=None, pool=None, params=None, rotation="live", profile="maniskill",
-             progress="off", threads=1):
+             progress="off", threads=1, policy_version=None, policy_files=None):
     """Run ``policy`` (a callable obs -> 7 canonical numbers; its ``reset()`` is called at each
-    episode start if it has one) as the backbone of one hash-addressed job, in this process,
+    episode start if it has one; or the name of one of the library's backbones, ``"expert"``,
+    ``"ppo"``, ``"mlp:DIR"``, as ``actionshift run --backbone`` takes it) as the backbone of one hash-addressed job, in this process,
     through the library's runner: ``<out>/<job id>.jsonl`` and ``.summary.json``, exactly as
     ``actionshift run`` writes them. Returns a dict with ``job_id``, ``jsonl_path``,
     ``summary_path``, ``episodes_run``, ``wall_time_s`` and the ``job`` spec.
@@ -279,11 +285,26 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     calls its own ``copy.deepcopy(policy)`` (as ``actionshift run --threads N`` starts one external
     process per worker), the simulation runs in parallel and only the policy calls take turns on the
     GIL. A plain function is not copied by ``deepcopy``: it must not keep state between calls.
+
+    method: a method name or label (``"entropy_probes{calibrated}"``), or an object of your own with
+    ``begin_episode(seed)``, ``encode(canonical, R)`` (returning 7 numbers, or ``(raw, probe)``) and
+    ``observe(raw, response, R)``, optionally ``setup(inputs)`` (called before each episode with what
+    its rung allows) and the attributes ``name``, ``version``, ``rung`` (``"pool"``, ``"grammar"`` or
+    ``"none"``, the default), ``params`` (the JSON values that configure it) and ``files``. It is run
+    by the library's runner as a user method (docs/methods.md); its records and summary are those of
+    a built-in method.
+
+    Identity (docs/methods.md): a Python policy enters the job id by its content (its code, closure
+    and global values, its attributes, ``policy_files``), so two different callables never share a
+    job; ``policy_version="..."`` names it instead of its code (for a policy whose content cannot be
+    hashed, such as one holding a GPU model: then also pass its weights as ``policy_files``). A method
+    object enters by its class's code, its ``params`` (or, without them, its attributes), version,
+    rung and ``files``.
     """
     if seed is None:
         raise ValueError("seed: must be an integer in [0, 2**64) (got None)")
     _check_seed(seed)
-    for name, value in (("task", task), ("split", split), ("method", method), ("rotation", rotation),
+    for name, value in (("task", task), ("split", split), ("rotation", rotation),
                         ("profile", profile), ("progress", progress)):
         if not isinstance(value, str):
             raise TypeError(f"evaluate: {name}: expected str (got {type(value).__name__})")
@@ -300,12 +321,31 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
             raise TypeError(f"evaluate: {name}: expected int (got {type(value).__name__})")
         if not lo <= value <= hi:
             raise ValueError(f"evaluate: {name}: {why} (got {value})")
+    if isinstance(policy, str):  # a backbone of the library: "expert", "ppo", "mlp:DIR", "external:<command>"
+        if backbone is not None and backbone != policy:
+            raise ValueError("evaluate: backbone: a backbone given by name is its own name (drop backbone=)")
+        backbone = policy
     if backbone is None:
         target = policy if hasattr(policy, "__qualname__") else type(policy)
         backbone = f"python:{getattr(target, '__module__', '?')}.{target.__qualname__}"
+    backbone_sha256 = None
+    if not backbone.startswith("external:") and not isinstance(policy, str):
+        if not callable(policy):
+            raise TypeError("policy: must be callable (obs -> 7 numbers)")
+        backbone_sha256, _ = _identity.policy_identity(policy, backbone, policy_version, policy_files)
+    elif policy_version is not None or policy_files is not None:
+        raise ValueError("evaluate: policy_version/policy_files: they name a Python callable; a backbone given by "
+                         "name or as external:<command> is identified as `actionshift run --backbone` identifies it")
+    method_object, method_identity = None, None
+    if not isinstance(method, str):
+        if params is not None:
+            raise ValueError("evaluate: params: a method object carries its own `params`")
+        method_object, method_identity = method, _identity.method_identity(method)
+        method = method_identity["name"]
     return _native._evaluate(policy, task, split, method, int(seed), int(episodes), _os.fspath(out), backbone,
                              None if pool is None else _os.fspath(pool),
-                             params, rotation, profile, progress, int(threads))
+                             params, rotation, profile, progress, int(threads), method_object, method_identity,
+                             backbone_sha256)
 
 
 def serve_policy(policy, stdin=None, stdout=None):

@@ -2,6 +2,8 @@
 // This is the only translation unit that includes pybind11: contracts and the core, manifests and
 // pools, the hidden-contract environment (single and vectorised), adapters, the self-test, and
 // evaluate() running a Python callable as the backbone through the library's own job runner.
+#include "actionshift/adapt/plugin.hpp"
+#include "actionshift/adapt/pool_belief.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/response.hpp"
 #include "actionshift/core/contract.hpp"
@@ -772,6 +774,145 @@ py::dict bench_policy_calls(py::object policy, const std::string& command, const
   return d;
 }
 
+// ---------------------------------------------------------------- user methods from Python
+
+// What a Python method is handed before each episode (setup(inputs)): exactly its rung's inputs.
+py::dict plugin_inputs_dict(const adapt::PluginInputs& in) {
+  py::dict d;
+  d["task"] = in.task;
+  d["rung"] = std::string(adapt::rung_name(in.rung));
+  d["params"] = json_to_py(in.params.dump());
+  d["pool"] = in.pool ? py::cast(*in.pool) : py::none();
+  d["calibration"] = in.model ? py::cast(*in.model) : py::none();
+  if (in.grammar) {
+    py::dict g;
+    g["scales"] = in.grammar->scales;
+    g["lags"] = in.grammar->lags;
+    g["targets"] = in.grammar->targets;
+    g["frames"] = in.grammar->frames;
+    g["permutations"] = in.grammar->permutations;
+    g["signs"] = in.grammar->signs;
+    g["gripper_inversion"] = in.grammar->gripper_inversion;
+    d["grammar"] = g;
+  } else {
+    d["grammar"] = py::none();
+  }
+  return d;
+}
+
+// A Python object with begin_episode / encode / observe (and optionally setup, observe_fingers) as an
+// adapt::Adapter. encode returns 7 numbers, or (7 numbers, probe) to mark a probe step.
+class PythonAdapter final : public adapt::Adapter {
+ public:
+  PythonAdapter(std::shared_ptr<py::object> obj, std::string name, const adapt::PluginInputs& in)
+      : obj_(std::move(obj)), name_(std::move(name)) {
+    py::gil_scoped_acquire gil;
+    if (py::hasattr(*obj_, "setup")) obj_->attr("setup")(plugin_inputs_dict(in));
+  }
+  ~PythonAdapter() override {
+    py::gil_scoped_acquire gil;
+    obj_.reset();
+  }
+  std::string name() const override { return name_; }
+  void begin_episode(std::uint64_t seed) override {
+    keep_python_thread_state();
+    py::gil_scoped_acquire gil;
+    if (py::hasattr(*obj_, "begin_episode")) obj_->attr("begin_episode")(seed);
+  }
+  Action encode(const Action& canonical, const Mat3& R) override {
+    keep_python_thread_state();
+    py::gil_scoped_acquire gil;
+    py::object out = obj_->attr("encode")(vec_out(canonical), mat_out(R));
+    last_ = {};
+    if (py::isinstance<py::tuple>(out) && py::len(out) == 2) {
+      last_.probe = py::bool_(out[py::int_(1)]);
+      out = out[py::int_(0)];
+    }
+    const std::string what = "method " + name_ + ": encode";
+    Action raw;
+    try {
+      raw = to_vec<kActionDim>(out, what.c_str());
+    } catch (py::error_already_set& e) {
+      throw InputError("method " + name_, "encode", std::string(py::str(e.value())));
+    }
+    if (!raw.allFinite()) throw InputError("method " + name_, "encode", "returned a NaN or infinite raw action");
+    return raw;
+  }
+  void observe(const Action& raw, const Pose6& response, const Mat3& R) override {
+    keep_python_thread_state();
+    py::gil_scoped_acquire gil;
+    if (py::hasattr(*obj_, "observe")) obj_->attr("observe")(vec_out(raw), vec_out(response), mat_out(R));
+  }
+  void observe_fingers(double finger_delta) override {
+    keep_python_thread_state();
+    py::gil_scoped_acquire gil;
+    if (py::hasattr(*obj_, "observe_fingers")) obj_->attr("observe_fingers")(finger_delta);
+  }
+  adapt::StepInfo last_step() const override { return last_; }
+
+ private:
+  std::shared_ptr<py::object> obj_;
+  std::string name_;
+  adapt::StepInfo last_;
+};
+
+// The Python method's objects: the one given (one worker) or a copy.deepcopy per worker thread.
+struct PythonMethodObjects {
+  std::shared_ptr<py::object> prototype;
+  bool copy_per_worker{false};
+  std::mutex mutex;
+  std::map<std::thread::id, std::shared_ptr<py::object>> copies;
+
+  std::shared_ptr<py::object> for_this_thread() {
+    if (!copy_per_worker) return prototype;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto& c = copies[std::this_thread::get_id()];
+    if (!c) {
+      keep_python_thread_state();
+      py::gil_scoped_acquire gil;
+      c = std::make_shared<py::object>(deepcopy(*prototype));
+    }
+    return c;
+  }
+  ~PythonMethodObjects() {
+    py::gil_scoped_acquire gil;
+    copies.clear();
+    prototype.reset();
+  }
+};
+
+// Registers a Python method object for the duration of one evaluate() call.
+adapt::MethodRegistration register_python_method(py::object obj, const py::dict& identity, unsigned workers) {
+  adapt::MethodPlugin p;
+  p.name = identity["name"].cast<std::string>();
+  p.version = identity["version"].cast<std::string>();
+  p.rung = adapt::parse_rung(identity["rung"].cast<std::string>(), "method " + p.name, "rung");
+  p.code_sha256 = identity["code_sha256"].cast<std::string>();
+  p.files = identity["files"].cast<std::vector<std::string>>();
+  p.params = parse_json_input(identity["params"].cast<std::string>(), "method " + p.name, "params");
+  for (const char* m : {"begin_episode", "encode"})
+    if (!py::hasattr(obj, m))
+      throw InputError("method " + p.name, m, "missing: a method object has begin_episode(seed), encode(canonical, R) and observe(raw, response, R)");
+  auto objects = std::make_shared<PythonMethodObjects>();
+  objects->prototype = std::make_shared<py::object>(std::move(obj));
+  objects->copy_per_worker = workers > 1;
+  if (objects->copy_per_worker) {
+    try {
+      deepcopy(*objects->prototype);
+    } catch (py::error_already_set& e) {
+      const std::string why = e.what();
+      throw InputError("evaluate", "threads",
+                       "each of the " + std::to_string(workers) + " workers needs copy.deepcopy(method), which failed (" +
+                           why.substr(0, why.find('\n')) + "); use threads=1");
+    }
+  }
+  const std::string name = p.name;
+  p.factory = [objects, name](const adapt::PluginInputs& in) -> std::unique_ptr<adapt::Adapter> {
+    return std::make_unique<PythonAdapter>(objects->for_this_thread(), name, in);
+  };
+  return adapt::register_method(std::move(p), "python");
+}
+
 // backbone identity of a Python policy: "external:<command>" hashes the command exactly as the
 // external-process backbone does (so the job is the one `actionshift run --backbone` writes);
 // any other name is hashed as a whole.
@@ -791,8 +932,12 @@ eval::BackboneRef backbone_ref(const std::string& name, sim::TaskId task) {
 py::dict evaluate(py::object policy, const std::string& task, const std::string& split, const std::string& method,
                   std::uint64_t seed, std::int64_t episodes, const std::string& out, const std::string& backbone,
                   std::optional<std::string> pool, py::object params, const std::string& rotation,
-                  const std::string& profile, const std::string& progress, int threads) {
-  if (!PyCallable_Check(policy.ptr())) throw py::type_error("policy: must be callable (obs -> 7 numbers)");
+                  const std::string& profile, const std::string& progress, int threads, py::object method_object,
+                  py::object method_identity, std::optional<std::string> backbone_sha256) {
+  // a string names a backbone of the library (expert, mlp:..., ppo:..., external:...), as `run --backbone`
+  const bool builtin_backbone = py::isinstance<py::str>(policy);
+  if (!builtin_backbone && !PyCallable_Check(policy.ptr()))
+    throw py::type_error("policy: must be callable (obs -> 7 numbers) or a backbone name");
   if (threads < 0) throw InputError("evaluate", "threads", "must be 0 (all cores) or a positive count (got " + std::to_string(threads) + ")");
   env_config_for_profile(profile);  // validates the name
   eval::JobRequest q;
@@ -808,13 +953,24 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.episodes = episodes;
   q.source = "evaluate";
   eval::PlanResolver resolver = eval::default_resolver();
-  resolver.backbone = [](const std::string& t, const std::string& name) { return backbone_ref(name, sim::parse_task(t)); };
-  const eval::JobSpec job = eval::resolve_job(q, resolver);
+  if (builtin_backbone) resolver.backbone = eval::default_resolver().backbone;  // the CLI's identity
+  else resolver.backbone = [&backbone_sha256](const std::string& t, const std::string& name) {
+    eval::BackboneRef ref = backbone_ref(name, sim::parse_task(t));
+    if (backbone_sha256 && !name.starts_with("external:")) ref.sha256 = *backbone_sha256;  // the callable's content
+    return ref;
+  };
   // threads > 1: the physics of the episodes runs in parallel without the GIL; each worker calls its
   // own copy.deepcopy of the policy (a stateful policy must not see two episodes at once). Checked
   // here, so a policy that cannot be copied fails before any episode runs
   const unsigned workers = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : static_cast<unsigned>(threads);
-  if (workers > 1) {
+  // a Python method object: registered as a user method (kind "python") for this call only
+  adapt::MethodRegistration method_registration;
+  if (!method_object.is_none()) {
+    method_registration = register_python_method(method_object, method_identity.cast<py::dict>(), workers);
+    q.method.name = method_registration.name();
+  }
+  const eval::JobSpec job = eval::resolve_job(q, resolver);
+  if (workers > 1 && !builtin_backbone) {
     try {
       deepcopy(policy);
     } catch (py::error_already_set& e) {
@@ -824,8 +980,12 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
                            why.substr(0, why.find('\n')) + "); use threads=1");
     }
   }
-  auto prototype =
-      std::make_shared<PythonPolicy>(policy, job.backbone.name, job.backbone.sha256, sim::parse_task(task), workers > 1);
+  std::shared_ptr<const policy::Policy> prototype;
+  if (builtin_backbone) {
+    prototype = std::shared_ptr<const policy::Policy>(policy::make_policy(job.backbone.name, sim::parse_task(task)));
+  } else {
+    prototype = std::make_shared<PythonPolicy>(policy, job.backbone.name, job.backbone.sha256, sim::parse_task(task), workers > 1);
+  }
   eval::RunOptions ro;
   ro.threads = workers;
   ro.out_dir = out;
@@ -1302,9 +1462,56 @@ PYBIND11_MODULE(_native, m) {
       }, py::arg("prev_obs"), py::arg("obs"), py::arg("task"), "The TCP response (6) between two observations.");
 
   // ---- evaluation
+  py::class_<adapt::ResponseModel>(m, "ResponseModel",
+                                   "A task's calibrated response model: response_c ~ alpha_c * canonical_c, noise sigma_c "
+                                   "(docs/reference.md); what the pool and grammar rungs receive.")
+      .def_property_readonly("alpha", [](const adapt::ResponseModel& r) { return vec_out(r.alpha); })
+      .def_property_readonly("sigma", [](const adapt::ResponseModel& r) { return vec_out(r.sigma); })
+      .def_readonly("gripper_alpha", &adapt::ResponseModel::gripper_alpha)
+      .def_readonly("gripper_sigma", &adapt::ResponseModel::gripper_sigma)
+      .def("__repr__", [](const adapt::ResponseModel& r) {
+        std::ostringstream s;
+        s << "ResponseModel(alpha=[" << r.alpha[0] << ", ...], sigma=[" << r.sigma[0] << ", ...])";
+        return s.str();
+      });
+  py::class_<adapt::PoolBelief>(m, "PoolBelief",
+                                "Exact Bayesian belief over a pool of contracts (docs/adapters.md, Pool belief): one "
+                                "decoder replica per hypothesis, the calibrated Gaussian likelihood, MAP encoding.")
+      .def(py::init([](py::handle pool, const adapt::ResponseModel& model) {
+             return adapt::PoolBelief(to_contracts(pool, "pool"), model);
+           }), py::arg("pool"), py::arg("calibration"))
+      .def_property_readonly("size", &adapt::PoolBelief::size)
+      .def_property_readonly("pool", &adapt::PoolBelief::pool)
+      .def("reset", &adapt::PoolBelief::reset, "Uniform belief and fresh replicas (the start of an episode).")
+      .def("update", [](adapt::PoolBelief& b, py::handle raw, py::handle response, py::handle R) {
+             b.update(to_vec<kActionDim>(raw, "raw"), to_vec<kPoseDim>(response, "response"), to_rotation(R, "R"));
+           }, py::arg("raw"), py::arg("response"), py::arg("R") = py::none())
+      .def_property_readonly("log_probs", [](const adapt::PoolBelief& b) { return vec_out(b.log_probs()); })
+      .def("probs", [](const adapt::PoolBelief& b) { return vec_out(b.probs()); })
+      .def("entropy", &adapt::PoolBelief::entropy)
+      .def("map_index", &adapt::PoolBelief::map_index)
+      .def("map_encode", [](const adapt::PoolBelief& b, py::handle canonical, py::handle R) {
+             return vec_out(b.map_encode(to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R")));
+           }, py::arg("canonical"), py::arg("R") = py::none())
+      .def("encode_with", [](const adapt::PoolBelief& b, int h, py::handle canonical, py::handle R) {
+             if (h < 0 || h >= b.size()) value_error("h: must be in [0, " + std::to_string(b.size()) + ")");
+             return vec_out(b.encode_with(h, to_vec<kActionDim>(canonical, "canonical"), to_rotation(R, "R")));
+           }, py::arg("h"), py::arg("canonical"), py::arg("R") = py::none())
+      .def("preview", [](const adapt::PoolBelief& b, py::handle raw, py::handle R, bool lag_aware) {
+             std::vector<Action> out;
+             b.preview(to_vec<kActionDim>(raw, "raw"), to_rotation(R, "R"), lag_aware, out);
+             DArray a({static_cast<py::ssize_t>(out.size()), static_cast<py::ssize_t>(kActionDim)});
+             for (std::size_t h = 0; h < out.size(); ++h)
+               for (int c = 0; c < kActionDim; ++c) a.mutable_at(static_cast<py::ssize_t>(h), c) = out[h][c];
+             return a;
+           }, py::arg("raw"), py::arg("R") = py::none(), py::arg("lag_aware") = true,
+           "The canonical action each hypothesis would decode from `raw` now (rows: hypotheses), without changing state.");
+  m.def("method_rung", [](const std::string& method) { return std::string(adapt::rung_name(adapt::method_rung(method))); },
+        py::arg("method"));
   m.def("_evaluate", &evaluate, py::arg("policy"), py::arg("task"), py::arg("split"), py::arg("method"), py::arg("seed"),
         py::arg("episodes"), py::arg("out"), py::arg("backbone"), py::arg("pool"), py::arg("params"),
-        py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"));
+        py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"), py::arg("method_object") = py::none(),
+        py::arg("method_identity") = py::none(), py::arg("backbone_sha256") = py::none());
   m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec, "job")), "job")); },
         py::arg("job"));
 

@@ -3,6 +3,7 @@
 #include "actionshift/adapt/grammar_belief.hpp"
 #include "actionshift/adapt/identifier.hpp"
 #include "actionshift/adapt/methods.hpp"
+#include "actionshift/adapt/plugin.hpp"
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 
@@ -24,13 +25,18 @@ const std::vector<std::string>& method_names() {
 }
 
 bool method_needs_pool(const std::string& m) {
+  if (const auto plugin = find_method_plugin(m)) return plugin->rung == Rung::pool;
   return m != "oracle" && m != "no_adapt" && m != "grammar_belief" && !parse_identifier_kind(m);
 }
-bool method_needs_calibration(const std::string& m) { return method_needs_pool(m) || m == "grammar_belief"; }
+bool method_needs_calibration(const std::string& m) {
+  if (const auto plugin = find_method_plugin(m)) return plugin->rung == Rung::pool || plugin->rung == Rung::grammar;
+  return method_needs_pool(m) || m == "grammar_belief";
+}
 
 namespace {
 
 nlohmann::json defaults(const std::string& m) {
+  if (const auto plugin = find_method_plugin(m)) return plugin->params;
   if (m == "oracle" || m == "no_adapt" || m == "exact_belief") return nlohmann::json::object();
   if (m == "grammar_belief")  // the reference's operating points: 6 fixed pulses of 0.5; hold h2-r1 over 6 channels
     // the scale corrector's defaults are the reference's (§4.7: window 16, bounds 0.4..2.5, floor 0.05)
@@ -78,10 +84,13 @@ ProbeOptions probe_options(const nlohmann::json& p) {
 
 nlohmann::json resolve_method_params(const std::string& method, const nlohmann::json& params) {
   const auto& names = method_names();
-  if (std::find(names.begin(), names.end(), method) == names.end()) {
+  const auto plugin = find_method_plugin(method);
+  if (!plugin && std::find(names.begin(), names.end(), method) == names.end()) {
     std::string known;
     for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("method", printable_input(method), "unknown method (known: " + known + ")");
+    for (const auto& n : method_plugin_names()) known += ", " + n;
+    throw InputError("method", printable_input(method),
+                     "unknown method (known: " + known + "; a method of your own must be registered first, docs/methods.md)");
   }
   if (!params.is_object()) throw InputError("method", method, "parameters must be a JSON object");
   nlohmann::json out = defaults(method);
@@ -106,6 +115,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
       throw InputError("method " + method, it.key(), "out of range (got " + v.dump() + ")");
     out[it.key()] = d.is_number_float() ? nlohmann::json(v.get<double>()) : v;
   }
+  if (plugin) return out;  // a plug-in checks its own values (its factory may throw InputError)
   if (out.contains("budget") && (out["budget"].get<int>() < 0 || out["budget"].get<int>() > 1000))
     throw InputError("method " + method, "budget", "must be in [0, 1000]");
   if (out.contains("amplitude")) {
@@ -157,6 +167,26 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
 }
 
 std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& p, const MethodInputs& in) {
+  if (const auto plugin = find_method_plugin(method)) {
+    // exactly what the declared rung allows: never the truth; the pool only to the pool rung
+    PluginInputs pi;
+    pi.task = in.task;
+    pi.rung = plugin->rung;
+    pi.params = p;
+    if (plugin->rung == Rung::pool) {
+      if (!in.pool || in.pool->empty())
+        throw InputError("method", method, "declares the pool rung and needs a pool (--pool on the command line, pool= in Python)");
+      pi.pool = in.pool;
+    }
+    if (plugin->rung == Rung::pool || plugin->rung == Rung::grammar) {
+      if (!in.model) throw InputError("method", method, "needs a response calibration");
+      pi.model = in.model;
+      pi.grammar = &grammar_grids();
+    }
+    auto adapter = plugin->factory(pi);
+    if (!adapter) throw InputError("method", method, "its factory returned no adapter");
+    return adapter;
+  }
   if (method == "no_adapt") return std::make_unique<NoAdaptAdapter>();
   if (method == "grammar_belief") {  // grammar + calibration only: never given the truth or the pool
     if (!in.model) throw InputError("method", method, "needs a response calibration");

@@ -2,6 +2,7 @@
 
 #include "actionshift/adapt/identifier.hpp"
 
+#include "actionshift/adapt/plugin.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/scale_corrector.hpp"
 #include "actionshift/adapt/response.hpp"
@@ -94,15 +95,23 @@ namespace {
 std::string method_variant_uncached(const JobSpec& job) {
   const auto& known = adapt::method_names();
   const nlohmann::json params = parse_params(job.method_params, job.method);
-  if (std::find(known.begin(), known.end(), job.method) != known.end())
+  // a user method's label lists every parameter its job has, so it is the same whether or not the
+  // method is registered in the process that reads its records
+  if (!job.method_plugin && std::find(known.begin(), known.end(), job.method) != known.end())
     return adapt::method_variant_label(job.method, adapt::resolve_method_params(job.method, params));
-  // a method outside the registry (a test's stand-in): every parameter it has is part of its label
+  // a user method, or a method outside the registry (a test's stand-in): every parameter it has is part of its label
   std::string items;
   for (auto it = params.begin(); it != params.end(); ++it)
     items += (items.empty() ? "" : ",") + it.key() + "=" + (it.value().is_string() ? it.value().get<std::string>() : canonical_dump(it.value()));
   return items.empty() ? job.method : job.method + "{" + items + "}";
 }
 }  // namespace
+
+std::optional<MethodPluginRef> method_plugin_ref(const std::string& method) {
+  const auto id = adapt::method_plugin_identity(method);
+  if (!id) return std::nullopt;
+  return MethodPluginRef{id->kind, id->version, id->rung, id->sha256, id->files};
+}
 
 PlanResolver default_resolver() {
   PlanResolver r;
@@ -127,6 +136,7 @@ PlanResolver default_resolver() {
   r.check_method = [](const MethodEntry& m) { adapt::resolve_method_params(m.name, parse_params(m.params, m.name)); };
   r.method_params = [](const MethodEntry& m) { return resolved_method_params(m.name, m.params); };
   r.method_uses_pool = [](const MethodEntry& m) { return adapt::method_needs_pool(m.name); };
+  r.method_plugin = [](const MethodEntry& m) { return method_plugin_ref(m.name); };
   return r;
 }
 
@@ -185,6 +195,7 @@ struct Context {
     if (oracle) in.truth = &oracle->contract();
     if (!pool.empty()) in.pool = &pool;
     if (response) in.model = &*response;
+    in.task = job.task;
     in.gain_fit = &adapt::fit_window_gain;  // the scale corrector's least-squares fit by Ceres (ActionShift::fit)
     const auto adapter = adapt::make_adapter(job.method, params, in);
 
@@ -236,6 +247,26 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
                            const std::optional<adapt::ResponseCalibration>& given_calibration,
                            const std::string& calibration_source = "calibration");
 }  // namespace
+
+void check_method_plugin(const JobSpec& job) {
+  const std::optional<MethodPluginRef> now = method_plugin_ref(job.method);
+  if (!job.method_plugin) {
+    if (now)
+      throw InputError("job", "method.plugin",
+                       "names no user method, but '" + job.method + "' is one registered here; make the job again");
+    return;
+  }
+  const MethodPluginRef& want = *job.method_plugin;
+  if (!now)
+    throw InputError("job", "method.name",
+                     "'" + job.method + "' is a user method (" + want.kind + ", version " + want.version +
+                         ") that is not registered in this process; register it before running its job (docs/methods.md)");
+  if (now->sha256 != want.sha256)
+    throw InputError(want.files.empty() ? "job" : want.files.front(), "method.plugin.sha256",
+                     "user method '" + job.method + "' is now version " + now->version + " (" + now->kind + ", rung " + now->rung +
+                         ", content " + now->sha256.substr(0, 12) + "), the job's version " + want.version + " (" + want.kind +
+                         ", rung " + want.rung + ", content " + want.sha256.substr(0, 12) + "); make the job again");
+}
 
 EpisodeFn make_episode_fn(const JobSpec& job, const EpisodeFnOptions& options) { return make_episode_fn(job, options, EpisodeHooks{}); }
 
@@ -325,6 +356,7 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
   ctx->prototype = std::move(backbone);
   if (ctx->prototype->sha256() != job.backbone.sha256)
     throw InputError("backbone " + job.backbone.name, "sha256", "is " + ctx->prototype->sha256() + " but the job was planned with " + job.backbone.sha256);
+  check_method_plugin(job);
   ctx->params = adapt::resolve_method_params(job.method, parse_params(job.method_params, job.method));
   // parameters that need the calibration, and missing or corrupt identifier weights, fail here, before any episode
   if (job.method == "grammar_belief" || adapt::parse_identifier_kind(job.method)) {

@@ -67,6 +67,15 @@ void validate_job(const JobSpec& job, const std::string& src) {
   check_hash(job.split.sha256, src, "split.sha256");
   if (job.split.contracts <= 0) throw InputError(src, "split.contracts", "must be > 0 (got " + std::to_string(job.split.contracts) + ")");
   check_token(job.method, src, "method.name");
+  if (job.method_plugin) {
+    const auto& m = *job.method_plugin;
+    if (m.kind != "cpp" && m.kind != "python" && m.kind != "external")
+      throw InputError(src, "method.plugin.kind", "expected cpp, python or external (got " + quote_input(m.kind, '"') + ")");
+    if (m.rung != "pool" && m.rung != "grammar" && m.rung != "none")
+      throw InputError(src, "method.plugin.rung", "expected pool, grammar or none (got " + quote_input(m.rung, '"') + ")");
+    if (m.version.empty()) throw InputError(src, "method.plugin.version", "must not be empty");
+    check_hash(m.sha256, src, "method.plugin.sha256");
+  }
   const json params = parse_params(job.method_params, src);
   try {
     (void)canonical_dump(params);  // rejects non-finite floats
@@ -114,6 +123,10 @@ nlohmann::json job_to_json(const JobSpec& job) {
   j["task"] = job.task;
   j["split"] = {{"name", job.split.name}, {"sha256", job.split.sha256}, {"contracts", job.split.contracts}};
   j["method"] = {{"name", job.method}, {"params", parse_params(job.method_params, "job")}};
+  if (job.method_plugin)
+    j["method"]["plugin"] = {{"kind", job.method_plugin->kind},     {"version", job.method_plugin->version},
+                             {"rung", job.method_plugin->rung},     {"sha256", job.method_plugin->sha256},
+                             {"files", job.method_plugin->files}};
   j["backbone"] = {{"name", job.backbone.name}, {"sha256", job.backbone.sha256}};
   j["pool"] = job.pool ? json{{"name", job.pool->name}, {"sha256", job.pool->sha256}} : json(nullptr);
   j["calibration_sha256"] = job.calibration_sha256 ? json(*job.calibration_sha256) : json(nullptr);
@@ -135,6 +148,7 @@ nlohmann::json job_identity_json(const JobSpec& job) {
   json j = job_to_json(job);
   if (job.robot) j["robot"] = {{"sha256", job.robot->sha256}};
   if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}};
+  if (job.method_plugin) j["method"]["plugin"].erase("files");
   return j;
 }
 
@@ -204,7 +218,26 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
     throw InputError(src, "split.contracts", "expected a positive integer");
   job.split.contracts = static_cast<std::int64_t>(*contracts);
   const json& method = j.at("method");
-  check_keys(method, {"name", "params"}, src, "method");
+  if (method.is_object() && method.contains("plugin")) {
+    const json& p = method.at("plugin");
+    check_keys(p, {"files", "kind", "rung", "sha256", "version"}, src, "method.plugin");
+    MethodPluginRef ref;
+    ref.kind = str_at(p, "kind", src, "method.plugin.kind");
+    ref.version = str_at(p, "version", src, "method.plugin.version");
+    ref.rung = str_at(p, "rung", src, "method.plugin.rung");
+    ref.sha256 = str_at(p, "sha256", src, "method.plugin.sha256");
+    if (!p.at("files").is_array()) throw InputError(src, "method.plugin.files", "expected a list of paths");
+    for (const auto& v : p.at("files")) {
+      if (!v.is_string()) throw InputError(src, "method.plugin.files", "expected a list of paths");
+      ref.files.push_back(v.get<std::string>());
+    }
+    job.method_plugin = std::move(ref);
+    json rest = method;
+    rest.erase("plugin");
+    check_keys(rest, {"name", "params"}, src, "method");
+  } else {
+    check_keys(method, {"name", "params"}, src, "method");
+  }
   job.method = str_at(method, "name", src, "method.name");
   if (!method.at("params").is_object()) throw InputError(src, "method.params", "expected an object");
   job.method_params = canonical_dump(method.at("params"));

@@ -316,6 +316,7 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.split = resolver.split(q.task, q.split);
   job.method = method.name;
   job.method_params = resolver.method_params ? resolver.method_params(method) : method.params;
+  if (resolver.method_plugin) job.method_plugin = resolver.method_plugin(method);
   job.backbone = resolver.backbone(q.task, q.backbone);
   if (q.pool && (!resolver.method_uses_pool || resolver.method_uses_pool(method))) job.pool = resolver.pool(*q.pool);
   job.calibration_sha256 = resolver.calibration ? resolver.calibration(q.task, method, q.profile) : std::nullopt;
@@ -391,6 +392,9 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
                                        : method.params;
         const bool uses_pool =
             !resolver.method_uses_pool || in_experiment(ex, method_field(m), [&] { return resolver.method_uses_pool(method); });
+        const std::optional<MethodPluginRef> plugin =
+            resolver.method_plugin ? in_experiment(ex, method_field(m), [&] { return resolver.method_plugin(method); })
+                                   : std::nullopt;
         for (const auto seed : ex.seeds) {
           PlannedJob pj;
           pj.index = static_cast<std::int64_t>(plan.jobs.size());
@@ -398,6 +402,7 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
           pj.spec.split = split;
           pj.spec.method = method.name;
           pj.spec.method_params = params;
+          pj.spec.method_plugin = plugin;
           pj.spec.backbone = backbone;
           if (uses_pool) pj.spec.pool = pools[split_name];
           pj.spec.calibration_sha256 = calibration;

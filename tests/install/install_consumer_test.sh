@@ -18,4 +18,12 @@ out=$("$WORK/build/render_consumer") || { echo "render consumer failed: $out"; e
 echo "$out"
 # the installed program must not load OSMesa (and llvmpipe's libLLVM) before it renders
 if ldd "$WORK/build/render_consumer" | grep -q libOSMesa; then echo "render consumer links libOSMesa"; exit 1; fi
+# the user-method example of docs/methods.md, built against the installed library alone
+EXAMPLE="$(cd "$CONSUMER/../../.." && pwd)/docs/examples/method_plugin"
+cmake -S "$EXAMPLE" -B "$WORK/method" -DCMAKE_PREFIX_PATH="$WORK/prefix" -DCMAKE_BUILD_TYPE=Release > "$WORK/method-configure.log" 2>&1 \
+  || { cat "$WORK/method-configure.log"; exit 1; }
+cmake --build "$WORK/method" > "$WORK/method-build.log" 2>&1 || { cat "$WORK/method-build.log"; exit 1; }
+out=$("$WORK/method/separation_example" "$WORK/method-results" 3) || { echo "method example failed: $out"; exit 1; }
+echo "$out"
+[ "$(wc -l < "$(awk '{print $2}' <<<"$out")")" = 3 ] || { echo "method example: expected 3 records"; exit 1; }
 echo "install consumer: ok"

@@ -64,7 +64,9 @@ def test_evaluate_errors(tmp_path, cli):
     with pytest.raises(Boom, match="policy failed"):
         actionshift.evaluate(broken, episodes=1, out=str(tmp_path))
     with pytest.raises(TypeError):
-        actionshift.evaluate("not callable", episodes=1, out=str(tmp_path))
+        actionshift.evaluate(42, episodes=1, out=str(tmp_path))
+    with pytest.raises(ValueError, match="unknown backbone 'not a backbone'"):  # a string names a library backbone
+        actionshift.evaluate("not a backbone", episodes=1, out=str(tmp_path))
     with pytest.raises(ValueError, match="profile"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), profile="no_such_profile")
     # a job's field errors name evaluate(), not the command line
@@ -137,9 +139,10 @@ def test_threads_errors(tmp_path):
             return np.zeros(7)
 
     with pytest.raises(ValueError, match=r"evaluate: threads: each of the 2 workers needs copy.deepcopy\(policy\)"):
-        actionshift.evaluate(Uncopyable(), episodes=2, out=str(tmp_path), threads=2)
+        actionshift.evaluate(Uncopyable(), episodes=2, out=str(tmp_path), threads=2, policy_version="1")
     assert not any(tmp_path.iterdir())  # nothing written
-    assert actionshift.evaluate(Uncopyable(), episodes=1, out=str(tmp_path), threads=1)["episodes_run"] == 1
+    assert actionshift.evaluate(Uncopyable(), episodes=1, out=str(tmp_path), threads=1,
+                                policy_version="1")["episodes_run"] == 1
     with pytest.raises(ValueError, match="threads: must be 0"):
         actionshift.evaluate(lambda obs: np.zeros(7), episodes=1, out=str(tmp_path), threads=-1)
 
@@ -165,13 +168,14 @@ def test_ctrl_c_stops_evaluate_and_the_job_resumes(tmp_path, threads):
 
     with pytest.raises(KeyboardInterrupt):
         actionshift.evaluate(InterruptsItself(), seed=4, episodes=300, out=str(tmp_path / "x"), threads=threads,
-                             backbone="python:zero")
+                             backbone="python:zero", policy_version="zero-1")
     jsonl = next((tmp_path / "x").glob("*.jsonl"))
     kept = jsonl.read_bytes().count(b"\n")
     assert kept < 300  # 300 episodes of 50 steps take seconds; the runner polls for Ctrl-C every 100 ms
     summary = json.loads(next((tmp_path / "x").glob("*.summary.json")).read_text())
     assert summary["message"] == f"interrupted after {kept} of 300 episodes; re-run to resume"
-    # the next call resumes where it stopped
+    # the next call resumes where it stopped: another callable, declared to be the same policy (a
+    # declared version names a policy instead of its code, so the job is the interrupted one)
     r = actionshift.evaluate(lambda obs: np.zeros(7), seed=4, episodes=300, out=str(tmp_path / "x"),
-                             threads=threads, backbone="python:zero")
+                             threads=threads, backbone="python:zero", policy_version="zero-1")
     assert r["episodes_before"] == kept and r["episodes_run"] == 300 - kept

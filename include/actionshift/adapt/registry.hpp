@@ -23,6 +23,7 @@ struct MethodInputs {
   const std::vector<Contract>* pool{nullptr};  ///< pool-privileged methods
   const ResponseModel* model{nullptr};        ///< belief methods (from the task's calibration)
   GainFit gain_fit{nullptr};                  ///< grammar_belief's scale corrector: its least-squares fit (null: closed form)
+  std::string task;                           ///< the task's name (handed to registered plug-ins)
 };
 
 /// Every method name, in ladder order (ceiling first).

@@ -56,6 +56,14 @@ std::string method_variant(const JobSpec& job);
 /// Throws InputError for a malformed label or invalid parameters of a registry method.
 std::string canonical_method_label(const std::string& label);
 
+/// The job identity of the user method registered as `method` (adapt::method_plugin_identity, its
+/// files hashed now), or nullopt for a built-in or unknown name.
+std::optional<MethodPluginRef> method_plugin_ref(const std::string& method);
+
+/// InputError unless the job's user method (JobSpec::method_plugin) is registered in this process with
+/// the same identity; also when the job names none but `job.method` is a registered user method.
+void check_method_plugin(const JobSpec& job);
+
 /// Run-time options of an episode function that do not change results (and so stay out of the job id).
 struct EpisodeFnOptions {
   policy::ExternalOptions external;  ///< timeouts of an external:<command> backbone (run --step-timeout)

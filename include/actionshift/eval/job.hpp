@@ -63,6 +63,18 @@ struct PolicyFilesRef {
   bool operator==(const PolicyFilesRef&) const = default;
 };
 
+/// A user method's identity (adapt::register_method; docs/methods.md): what it is, not only what it is
+/// called. Its kind, declared version, rung and content hash enter the job id; the paths of its files
+/// are recorded, not hashed.
+struct MethodPluginRef {
+  std::string kind;                  ///< "cpp", "python" or "external"
+  std::string version;               ///< declared version
+  std::string rung;                  ///< "pool", "grammar" or "none"
+  std::string sha256;                ///< adapt::PluginIdentity::sha256
+  std::vector<std::string> files;    ///< absolute paths of its files (recorded, not hashed)
+  bool operator==(const MethodPluginRef&) const = default;
+};
+
 /// sha256_hex(canonical_json([sha256_hex(bytes of each file)] sorted)): the content of a set of files,
 /// independent of their names, locations and order. Throws actionshift::InputError(path, field,
 /// "cannot read file") for an unreadable one and for an empty list.
@@ -83,6 +95,7 @@ struct JobSpec {
   SplitRef split;                            ///< evaluation split
   std::string method;                        ///< method name, e.g. "oracle", "no_adapt"
   std::string method_params{"{}"};           ///< JSON object text of the method's parameters
+  std::optional<MethodPluginRef> method_plugin;  ///< a registered user method's identity, or none (a built-in)
   BackboneRef backbone;                      ///< frozen policy
   std::optional<PoolRef> pool;               ///< declared pool, or none
   std::optional<std::string> calibration_sha256;  ///< 64-hex calibration hash, or none
@@ -105,14 +118,14 @@ inline constexpr std::int64_t kMaxJobEpisodes = 1'000'000'000;
 void validate_job(const JobSpec& job, const std::string& source = "job");
 
 /// The hashed object: {"backbone":{"name","sha256"},"calibration_sha256","episodes",
-/// "method":{"name","params"},"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
+/// "method":{"name","params"} (plus "plugin":{"files","kind","rung","sha256","version"} for a user method),"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
 /// "seed","split":{"contracts","name","sha256"},"task"}, plus "robot":{"packages","sha256","urdf"}
 /// only when the job names a robot, "policy_files":{"paths","sha256"} only when it names policy
 /// files, and "obs_noise" (a float) only when it is non-zero. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 
-/// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"} (paths are
-/// not identity).
+/// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"} and the method
+/// plug-in's "files" left out (paths are not identity).
 nlohmann::json job_identity_json(const JobSpec& job);
 
 /// Canonical JSON text of job_identity_json (sorted keys, no whitespace, Python-repr floats).

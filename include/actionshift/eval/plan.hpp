@@ -73,6 +73,9 @@ struct PlanResolver {
   /// If set: whether a method takes the experiment's pool (false: its jobs get no pool, so e.g. an
   /// oracle job has the same id with or without a pool in the experiment). Unset: every method does.
   std::function<bool(const MethodEntry& method)> method_uses_pool;
+  /// If set: the identity of a registered user method (adapt::register_method), nullopt for a
+  /// built-in. Unset: every method is a built-in.
+  std::function<std::optional<MethodPluginRef>(const MethodEntry& method)> method_plugin;
 };
 
 /// A single job by names, as on the `actionshift run --task T --split S --method M ...` command line.
