@@ -5,6 +5,7 @@
 #include "actionshift/eval/experiment.hpp"
 #include "actionshift/render/episode.hpp"
 #include "actionshift/render/image.hpp"
+#include "actionshift/render/leaderboard.hpp"
 #include "actionshift/render/report.hpp"
 #include "actionshift/sim/task.hpp"
 #include "commands.hpp"
@@ -149,7 +150,23 @@ int run_montage(const MontageOptions& o) {
 
 int run_report(const ReportOptions& o) {
   try {
-    const render::ReportResult r = render::write_report(o.results_dir, o.out_dir);
+    if (o.leaderboard) {
+      render::LeaderboardOptions lo;
+      lo.results_dirs = o.results_dirs;
+      lo.out_dir = o.out_dir;
+      lo.reference = o.reference;
+      lo.common_episodes = o.common_episodes;
+      lo.command = o.command;
+      const render::LeaderboardResult r = render::write_leaderboard(lo);
+      std::cout << "leaderboard: " << r.markdown_path << ", " << r.html_path << " and " << r.json_path << " ("
+                << r.methods << " methods, " << r.cells << " cells)\n";
+      return kOk;
+    }
+    if (o.results_dirs.size() != 1)
+      throw InputError("report", "results", "give one results directory (several only with --leaderboard)");
+    if (o.reference != "entropy_probes" || o.common_episodes)
+      throw InputError("report", o.common_episodes ? "--common-episodes" : "--reference", "applies to --leaderboard only");
+    const render::ReportResult r = render::write_report(o.results_dirs.front(), o.out_dir);
     std::cout << "report: " << r.html_path << " and " << r.markdown_path << " (" << counted(r.figures.size(), "figure") << ", "
               << r.summaries << " job summaries)\n";
     return kOk;

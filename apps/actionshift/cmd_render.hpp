@@ -43,8 +43,12 @@ int run_montage(const MontageOptions& o);
 
 // `actionshift report RESULTS_DIR --out DIR`
 struct ReportOptions {
-  std::string results_dir;
+  std::vector<std::string> results_dirs;
   std::string out_dir;
+  bool leaderboard{false};
+  std::string reference{"entropy_probes"};
+  bool common_episodes{false};
+  std::string command;  ///< the command line, printed on the leaderboard page
 };
 int run_report(const ReportOptions& o);
 

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 
 #include "actionshift/adapt/registry.hpp"
+#include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/sim/env.hpp"
 
@@ -28,6 +29,18 @@
 using namespace actionshift;
 
 namespace {
+
+// the command as typed, each argument shell-quoted when it needs it (printed on generated pages)
+std::string command_line(int argc, char** argv) {
+  std::string out = "actionshift";
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a(argv[i]);
+    const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./:=@,+") ==
+                                         std::string_view::npos;
+    out += " " + (plain ? std::string(a) : actionshift::eval::shell_quote(a));
+  }
+  return out;
+}
 
 // CLI11 parses "-1" into an unsigned option as 2**64 - 1 and saturates 2**64: seeds are checked as text
 const CLI::Validator kSeed(
@@ -650,9 +663,21 @@ int main(int argc, char** argv) {
       "report", "Write a self-contained HTML page (index.html) and Markdown (report.md) for a results directory:\n"
                 "the results summary table, gate verdicts, SVG figures (Gate 1, adaptation ladders, probe-cost\n"
                 "Pareto, long lag; a figure whose inputs are absent is skipped) and the provenance of every number.");
-  report->add_option("results", report_o.results_dir, "Results directory")->required();
+  report->add_option("results", report_o.results_dirs,
+                     "Results directory (with --leaderboard: one or more, merged as `compare` merges them)")->required();
   report->add_option("--out", report_o.out_dir, "Output directory")->required();
-  report->callback([&] { action = [&] { return cli::run_report(report_o); }; });
+  report->add_flag("--leaderboard", report_o.leaderboard,
+                   "Write the leaderboard instead (leaderboard.md, .html, .json): every method label against\n"
+                   "--reference on each (task, split, backbone) where both ran: success with its Wilson interval,\n"
+                   "the paired bootstrap difference and the promotion verdict; a method of your own is one more row");
+  report->add_option("--reference", report_o.reference, "--leaderboard: the method every row is compared with")
+      ->capture_default_str();
+  report->add_flag("--common-episodes", report_o.common_episodes,
+                   "--leaderboard: pair only the episodes both cells hold (as `compare --common-episodes`)");
+  report->callback([&] {
+    report_o.command = command_line(argc, argv);
+    action = [&] { return cli::run_report(report_o); };
+  });
 
   if (const std::string unknown = unknown_command(app, argc, argv); !unknown.empty()) {
     std::cerr << "actionshift: error: " << unknown << " (see --help)\n";

@@ -1,0 +1,234 @@
+// the leaderboard page: every method label against a reference method, cell by cell, from compare's numbers
+#include "actionshift/render/leaderboard.hpp"
+
+#include "actionshift/adapt/plugin.hpp"
+#include "actionshift/adapt/registry.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/core/input_file.hpp"
+#include "actionshift/core/json_input.hpp"
+#include "actionshift/eval/compare.hpp"
+#include "actionshift/eval/job.hpp"
+#include "actionshift/eval/provenance.hpp"
+#include "actionshift/eval/statistics.hpp"
+#include "actionshift/eval/summary.hpp"
+#include "xml_escape.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+namespace actionshift::render {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+using CellId = std::tuple<std::string, std::string, std::string>;  // task, split, backbone
+
+std::string cell_name(const CellId& c) { return std::get<0>(c) + "/" + std::get<1>(c) + " · " + std::get<2>(c); }
+
+std::string r3(double x) { return eval::fixed(x, 3); }
+std::string signed3(double x) { return (x >= 0 ? "+" : "") + eval::fixed(x, 3); }
+
+struct Row {
+  std::string label, rung, kind;
+  std::map<CellId, json> cells;        // compare's cell
+  std::map<CellId, json> comparisons;  // compare's comparison with the reference
+  double mean_success{0.0};
+};
+
+// a user method's rung and kind, from the summary of one of its jobs (the job spec names them)
+std::pair<std::string, std::string> declared_rung(const std::vector<std::string>& dirs, const json& jobs) {
+  for (const auto& id : jobs) {
+    for (const auto& dir : dirs) {
+      const fs::path p = fs::path(dir) / eval::summary_file_name(id.get<std::string>());
+      std::error_code ec;
+      if (!fs::is_regular_file(p, ec)) continue;
+      const json s = parse_json_input(read_input_file(p.string(), "job summary"), p.string());
+      if (!s.is_object() || !s.contains("job") || !s["job"].contains("method")) continue;
+      const json& m = s["job"]["method"];
+      if (m.contains("plugin") && m["plugin"].is_object())
+        return {m["plugin"].value("rung", "?"), m["plugin"].value("kind", "?")};
+      return {"?", "?"};
+    }
+  }
+  return {"?", "?"};
+}
+
+std::pair<std::string, std::string> rung_of(const std::string& label, const std::vector<std::string>& dirs, const json& jobs) {
+  const std::string base = eval::method_base_name(label);
+  const auto& builtin = adapt::method_names();
+  if (std::find(builtin.begin(), builtin.end(), base) != builtin.end())
+    return {std::string(adapt::rung_name(adapt::method_rung(base))), "built-in"};
+  return declared_rung(dirs, jobs);
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  require_replaceable_output(p.string());
+  std::ofstream f(p, std::ios::binary | std::ios::trunc);
+  f << text;
+  f.flush();
+  if (!f) throw InputError(p.string(), "--out", "cannot write file");
+}
+
+std::string md_cell(const std::string& s) {
+  std::string out;
+  for (const char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
+LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
+  if (o.results_dirs.empty()) throw InputError("leaderboard", "results", "name at least one results directory");
+  // the labels and cells present, to choose the pairs (every label against the reference where both ran)
+  std::map<std::string, std::set<CellId>> where;
+  std::size_t records = 0;
+  for (const auto& dir : o.results_dirs) {
+    const eval::ResultSet rs = eval::load_results(dir);
+    if (rs.records.empty()) throw InputError(dir, "", eval::no_records_reason(rs));
+    records += rs.records.size();
+    for (const auto& r : rs.records) where[r.method_variant].insert({r.task, r.split, r.backbone});
+  }
+  const auto ref = where.find(o.reference);
+  if (ref == where.end()) {
+    std::string known;
+    for (const auto& [label, cells] : where) known += (known.empty() ? "" : ", ") + label;
+    throw InputError("leaderboard", "--reference", "no cell holds '" + o.reference + "' (labels found: " + known + ")");
+  }
+  std::vector<eval::ComparisonPair> pairs;
+  for (const auto& [label, cells] : where) {
+    if (label == o.reference) continue;
+    const bool shared = std::any_of(cells.begin(), cells.end(), [&](const CellId& c) { return ref->second.count(c) > 0; });
+    if (shared) pairs.push_back(eval::ComparisonPair{label, o.reference});
+  }
+  const json cmp = eval::compare_directories(o.results_dirs, pairs, eval::builtin_paper_numbers(), o.common_episodes);
+
+  std::map<std::string, Row> rows;
+  std::set<CellId> columns;
+  for (const auto& c : cmp.at("cells")) {
+    const CellId id{c.at("task").get<std::string>(), c.at("split").get<std::string>(), c.at("backbone").get<std::string>()};
+    if (!ref->second.count(id)) continue;  // the board's cells are the reference's
+    columns.insert(id);
+    Row& row = rows[c.at("method").get<std::string>()];
+    row.label = c.at("method").get<std::string>();
+    row.cells[id] = c;
+  }
+  for (const auto& k : cmp.at("comparisons")) {
+    const CellId id{k.at("task").get<std::string>(), k.at("split").get<std::string>(), k.at("backbone").get<std::string>()};
+    rows[k.at("candidate").get<std::string>()].comparisons[id] = k;
+  }
+  std::vector<Row> order;
+  for (auto& [label, row] : rows) {
+    double sum = 0.0;
+    for (const auto& [id, c] : row.cells) sum += c.at("success_once").at("rate").get<double>();
+    row.mean_success = row.cells.empty() ? 0.0 : sum / static_cast<double>(row.cells.size());
+    const json jobs = row.cells.empty() ? json::array() : row.cells.begin()->second.at("jobs");
+    std::tie(row.rung, row.kind) = rung_of(label, o.results_dirs, jobs);
+    order.push_back(row);
+  }
+  std::stable_sort(order.begin(), order.end(), [](const Row& a, const Row& b) { return a.mean_success > b.mean_success; });
+
+  const eval::Provenance& prov = eval::build_provenance();
+  const std::string commit = prov.git_commit.empty() ? "unknown" : prov.git_commit;
+  std::ostringstream md, html;
+  md << "# Leaderboard\n\n"
+     << "Every method label of the results, against `" << o.reference << "` on the cells where it ran "
+     << "(task/split · backbone). Per cell: success (`success_once`) with its 95 % Wilson interval and n; "
+     << "Δ: the paired bootstrap difference from `" << o.reference << "` with its 95 % interval over the "
+     << "same episodes (same seed, contract and initial state), and the promotion verdict of "
+     << "`actionshift gate promote`. Rows are sorted by mean success over their cells. A difference whose "
+     << "interval includes 0 does not rank two methods. The intervals treat episodes as independent, but the "
+     << "contracts of one block share their initial state, so they are somewhat too narrow (docs/formats.md, "
+     << "\"Comparison\").\n\n"
+     << "Made by `" << (o.command.empty() ? "actionshift report --leaderboard" : o.command) << "` at commit `" << commit
+     << "` from " << records << " records in " << o.results_dirs.size() << " director" << (o.results_dirs.size() == 1 ? "y" : "ies")
+     << "; profile, seeds and episode counts are each job's (leaderboard.json, `inputs` and the cells' `per_seed`).\n\n";
+  md << "| method | rung | kind |";
+  for (const auto& c : columns) md << " " << md_cell(cell_name(c)) << " | Δ vs " << md_cell(o.reference) << " |";
+  md << "\n|---|---|---|";
+  for (std::size_t i = 0; i < columns.size(); ++i) md << "---|---|";
+  md << "\n";
+  html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>ActionShift leaderboard</title><style>"
+       << "body{font-family:sans-serif;margin:2em;max-width:80em}table{border-collapse:collapse}"
+       << "td,th{border:1px solid #ccc;padding:.3em .6em;text-align:right}td:first-child,th:first-child{text-align:left}"
+       << ".ref{background:#eef}.up{color:#060}.down{color:#a00}small{color:#555}</style></head><body>"
+       << "<h1>Leaderboard</h1><p>Every method against <code>" << detail::xml_escape(o.reference)
+       << "</code>: success with its 95&nbsp;% Wilson interval; &Delta;: the paired bootstrap difference with its 95&nbsp;% "
+       << "interval over the same episodes, and the promotion verdict. Sorted by mean success. An interval that includes 0 "
+       << "does not rank two methods.</p><p><small>Made by <code>"
+       << detail::xml_escape(o.command.empty() ? "actionshift report --leaderboard" : o.command) << "</code> at commit <code>"
+       << detail::xml_escape(commit) << "</code> from " << records << " records.</small></p><table><tr><th>method</th><th>rung</th><th>kind</th>";
+  for (const auto& c : columns)
+    html << "<th>" << detail::xml_escape(cell_name(c)) << "</th><th>&Delta; vs " << detail::xml_escape(o.reference) << "</th>";
+  html << "</tr>";
+  json board = json::array();
+  for (const auto& row : order) {
+    const bool is_ref = row.label == o.reference;
+    md << "| " << md_cell(is_ref ? "**" + row.label + "**" : row.label) << " | " << row.rung << " | " << row.kind << " |";
+    html << "<tr" << (is_ref ? " class=\"ref\"" : "") << "><td><code>" << detail::xml_escape(row.label) << "</code></td><td>"
+         << detail::xml_escape(row.rung) << "</td><td>" << detail::xml_escape(row.kind) << "</td>";
+    json entry = {{"method", row.label}, {"rung", row.rung}, {"kind", row.kind}, {"mean_success", row.mean_success},
+                  {"cells", json::array()}};
+    for (const auto& c : columns) {
+      const auto cell = row.cells.find(c);
+      const auto cmpi = row.comparisons.find(c);
+      std::string s = "–", d = is_ref ? "reference" : "–", hd = d;
+      if (cell != row.cells.end()) {
+        const json& w = cell->second.at("success_once");
+        s = r3(w.at("rate").get<double>()) + " [" + r3(w.at("lower").get<double>()) + ", " + r3(w.at("upper").get<double>()) +
+            "] n=" + std::to_string(w.at("total").get<std::int64_t>());
+      }
+      if (cmpi != row.comparisons.end()) {
+        const json& k = cmpi->second;
+        const json& diff = k.at("difference");
+        const double est = diff.at("estimate").get<double>();
+        d = signed3(est) + " [" + signed3(diff.at("lower").get<double>()) + ", " + signed3(diff.at("upper").get<double>()) + "] " +
+            k.at("promotion").at("verdict").get<std::string>();
+        const bool excl = diff.at("excludes_zero").get<bool>();
+        hd = std::string("<span class=\"") + (excl ? (est > 0 ? "up" : "down") : "") + "\">" + detail::xml_escape(d) + "</span>";
+        entry["cells"].push_back({{"task", std::get<0>(c)}, {"split", std::get<1>(c)}, {"backbone", std::get<2>(c)},
+                                  {"success_once", cell != row.cells.end() ? cell->second.at("success_once") : json(nullptr)},
+                                  {"difference", diff}, {"promotion", k.at("promotion")}});
+      } else if (cell != row.cells.end()) {
+        entry["cells"].push_back({{"task", std::get<0>(c)}, {"split", std::get<1>(c)}, {"backbone", std::get<2>(c)},
+                                  {"success_once", cell->second.at("success_once")}, {"difference", nullptr}, {"promotion", nullptr}});
+      }
+      md << " " << s << " | " << md_cell(d) << " |";
+      html << "<td>" << detail::xml_escape(s) << "</td><td>" << (cmpi != row.comparisons.end() ? hd : detail::xml_escape(d)) << "</td>";
+    }
+    md << "\n";
+    html << "</tr>";
+    board.push_back(entry);
+  }
+  md << "\nRungs: what the runner handed the method (`pool`: the declared pool, the calibration and the grammar's "
+        "grids; `grammar`: the calibration and the grids; `none`: nothing more; `oracle`: the true contract). Kind: "
+        "`built-in`, or how a user method entered (`cpp`, `python`, `external`; docs/methods.md).\n";
+  html << "</table><p><small>Rungs: what the runner handed the method (pool: the declared pool, the calibration and the "
+          "grammar's grids; grammar: the calibration and the grids; none: nothing more; oracle: the true contract).</small></p>"
+          "</body></html>\n";
+
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec) throw InputError(o.out_dir, "--out", "cannot create directory (" + ec.message() + ")");
+  LeaderboardResult r;
+  r.markdown_path = (fs::path(o.out_dir) / "leaderboard.md").string();
+  r.html_path = (fs::path(o.out_dir) / "leaderboard.html").string();
+  r.json_path = (fs::path(o.out_dir) / "leaderboard.json").string();
+  json doc = {{"reference", o.reference}, {"command", o.command}, {"commit", commit}, {"board", board}, {"comparison", cmp}};
+  write_text(r.markdown_path, md.str());
+  write_text(r.html_path, html.str());
+  write_text(r.json_path, doc.dump(1) + "\n");
+  r.methods = order.size();
+  r.cells = columns.size();
+  return r;
+}
+
+}  // namespace actionshift::render
