@@ -276,6 +276,10 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     ``actionshift run`` writes them. Returns a dict with ``job_id``, ``jsonl_path``,
     ``summary_path``, ``episodes_run``, ``wall_time_s`` and the ``job`` spec.
 
+    split, pool: a built-in name or a manifest file (``str`` or path-like) of any name and location.
+    The job is identified by the manifest's content hash; a file's absolute path is recorded in the
+    job (not hashed) and the manifest is read again from it, and checked, when the job runs.
+
     backbone: the backbone's name in the job. ``"external:<command>"`` gives the job (id and JSONL)
     that ``actionshift run --backbone "external:<command>"`` writes when that command serves the same
     policy (e.g. through ``serve_policy``); default ``"python:<module>.<name>"`` of the callable.
@@ -304,6 +308,8 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     if seed is None:
         raise ValueError("seed: must be an integer in [0, 2**64) (got None)")
     _check_seed(seed)
+    if isinstance(split, _os.PathLike):
+        split = _os.fspath(split)
     for name, value in (("task", task), ("split", split), ("rotation", rotation),
                         ("profile", profile), ("progress", progress)):
         if not isinstance(value, str):
@@ -313,8 +319,8 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     if backbone is not None and not isinstance(backbone, str):
         raise TypeError(f"evaluate: backbone: expected str or None (got {type(backbone).__name__})")
     if pool is not None and not isinstance(pool, (str, _os.PathLike)):
-        raise TypeError(f"evaluate: pool: expected a pool name or manifest path (a job records its pool by name and "
-                        f"hash; got {type(pool).__name__})")
+        raise TypeError(f"evaluate: pool: expected a pool name or manifest path (a job records its pool by hash, "
+                        f"and the path of a file; got {type(pool).__name__})")
     for name, value, lo, hi, why in (("episodes", episodes, 1, 2 ** 62, "must be > 0 and at most 2**62"),
                                      ("threads", threads, 0, 4096, "must be 0 (all cores) or a count up to 4096")):
         if not isinstance(value, (int, _np.integer)) or isinstance(value, bool):

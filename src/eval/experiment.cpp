@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -33,6 +34,26 @@ Manifest manifest_of_kind(const std::string& name, bool pool) {
   if (m.is_pool() != pool)
     throw InputError(name, "kind", pool ? "is a split manifest, not a pool" : "is a pool, not a split manifest");
   return m;
+}
+
+// The absolute path of a manifest named by a file ("" for a built-in name): recorded in the job, so
+// the job is resolved from the same file wherever it runs, never by the manifest's name.
+std::string manifest_file_path(const std::string& name_or_path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(name_or_path, ec)) return {};
+  const std::filesystem::path abs = std::filesystem::absolute(name_or_path, ec);
+  return ec ? std::string() : abs.lexically_normal().string();
+}
+
+// The manifest of a job's split or pool: the recorded file when the job has one, else the built-in
+// manifest of that name. Its content hash is checked by the caller.
+Manifest job_manifest(const std::string& name, const std::string& path, bool pool) {
+  if (path.empty()) return manifest_of_kind(name, pool);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(path, pool ? "pool.path" : "split.path",
+                     std::string("the ") + (pool ? "pool" : "split") + " manifest the job was made from is gone (not a regular file)");
+  return manifest_of_kind(path, pool);
 }
 
 nlohmann::json parse_params(const std::string& text, const std::string& method) {
@@ -117,11 +138,11 @@ PlanResolver default_resolver() {
   PlanResolver r;
   r.split = [](const std::string&, const std::string& split) {
     const Manifest m = manifest_of_kind(split, false);
-    return SplitRef{m.name(), m.manifest_sha256(), static_cast<std::int64_t>(m.test().size())};
+    return SplitRef{m.name(), m.manifest_sha256(), static_cast<std::int64_t>(m.test().size()), manifest_file_path(split)};
   };
   r.pool = [](const std::string& pool) {
     const Manifest m = manifest_of_kind(pool, true);
-    return PoolRef{m.name(), m.pool_sha256()};
+    return PoolRef{m.name(), m.pool_sha256(), manifest_file_path(pool)};
   };
   r.backbone = [](const std::string& task, const std::string& name) {
     // identity only: an external policy's process is started by the job, not by planning it
@@ -309,17 +330,20 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
   ctx->slice = tcp_slice(ctx->model->layout());
   ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
 
-  const Manifest split = manifest_of_kind(job.split.name, false);
+  // a split's identity is its content hash: the job's file when it names one, else the built-in name
+  const std::string split_source = job.split.path.empty() ? job.split.name : job.split.path;
+  const Manifest split = job_manifest(job.split.name, job.split.path, false);
   if (split.manifest_sha256() != job.split.sha256)
-    throw InputError(job.split.name, "manifest_sha256", "is " + split.manifest_sha256() + " but the job was planned with " + job.split.sha256);
+    throw InputError(split_source, "manifest_sha256", "is " + split.manifest_sha256() + " but the job was planned with " + job.split.sha256);
   ctx->contracts = split.contracts();
   if (static_cast<std::int64_t>(ctx->contracts.size()) != job.split.contracts)
-    throw InputError(job.split.name, "test", "holds a different number of contracts than the job");
+    throw InputError(split_source, "test", "holds a different number of contracts than the job");
 
   if (job.pool) {
-    const Manifest pool = manifest_of_kind(job.pool->name, true);
+    const std::string pool_source = job.pool->path.empty() ? job.pool->name : job.pool->path;
+    const Manifest pool = job_manifest(job.pool->name, job.pool->path, true);
     if (pool.pool_sha256() != job.pool->sha256)
-      throw InputError(job.pool->name, "pool_sha256", "is " + pool.pool_sha256() + " but the job was planned with " + job.pool->sha256);
+      throw InputError(pool_source, "pool_sha256", "is " + pool.pool_sha256() + " but the job was planned with " + job.pool->sha256);
     ctx->pool = pool.contracts();
   } else if (adapt::method_needs_pool(job.method)) {
     throw InputError("job", "pool", "method '" + job.method + "' needs a pool (--pool reference9|full|FILE)");

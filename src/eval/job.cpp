@@ -53,6 +53,12 @@ std::string str_at(const json& j, const char* key, const std::string& src, const
   return v.get<std::string>();
 }
 
+// a recorded manifest path: empty (a built-in manifest by name) or an absolute path
+void check_manifest_path(const std::string& path, const std::string& src, const std::string& field) {
+  if (!path.empty() && path.front() != '/')
+    throw InputError(src, field, "must be an absolute path (got " + quote_input(path, '"') + ")");
+}
+
 json parse_params(const std::string& text, const std::string& src) {
   const json p = parse_json_input(text, src, "method.params");
   if (!p.is_object()) throw InputError(src, "method.params", "expected a JSON object (got " + json_for_message(p) + ")");
@@ -88,6 +94,8 @@ void validate_job(const JobSpec& job, const std::string& src) {
     check_token(job.pool->name, src, "pool.name");
     check_hash(job.pool->sha256, src, "pool.sha256");
   }
+  check_manifest_path(job.split.path, src, "split.path");
+  if (job.pool) check_manifest_path(job.pool->path, src, "pool.path");
   if (job.calibration_sha256) check_hash(*job.calibration_sha256, src, "calibration_sha256");
   bool mode_ok = false;
   for (auto m : kRotationModes) mode_ok = mode_ok || job.rotation_mode == m;
@@ -122,6 +130,7 @@ nlohmann::json job_to_json(const JobSpec& job) {
   j["schema_version"] = std::string(kJobSchemaVersion);
   j["task"] = job.task;
   j["split"] = {{"name", job.split.name}, {"sha256", job.split.sha256}, {"contracts", job.split.contracts}};
+  if (!job.split.path.empty()) j["split"]["path"] = job.split.path;
   j["method"] = {{"name", job.method}, {"params", parse_params(job.method_params, "job")}};
   if (job.method_plugin)
     j["method"]["plugin"] = {{"kind", job.method_plugin->kind},     {"version", job.method_plugin->version},
@@ -129,6 +138,7 @@ nlohmann::json job_to_json(const JobSpec& job) {
                              {"files", job.method_plugin->files}};
   j["backbone"] = {{"name", job.backbone.name}, {"sha256", job.backbone.sha256}};
   j["pool"] = job.pool ? json{{"name", job.pool->name}, {"sha256", job.pool->sha256}} : json(nullptr);
+  if (job.pool && !job.pool->path.empty()) j["pool"]["path"] = job.pool->path;
   j["calibration_sha256"] = job.calibration_sha256 ? json(*job.calibration_sha256) : json(nullptr);
   j["rotation_mode"] = job.rotation_mode;
   j["profile"] = job.profile;
@@ -149,6 +159,9 @@ nlohmann::json job_identity_json(const JobSpec& job) {
   if (job.robot) j["robot"] = {{"sha256", job.robot->sha256}};
   if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}};
   if (job.method_plugin) j["method"]["plugin"].erase("files");
+  // a manifest's identity is its content hash: where the file lives is recorded, not hashed
+  j["split"].erase("path");
+  if (job.pool) j["pool"].erase("path");
   return j;
 }
 
@@ -209,7 +222,16 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
     throw InputError(src, "schema_version", "unsupported job schema version (got " + json_for_message(j.at("schema_version")) + ")");
   JobSpec job;
   job.task = str_at(j, "task", src, "task");
-  const json& split = j.at("split");
+  // "path" is optional in "split" and "pool": present only for a manifest given as a file
+  const auto without_path = [&](const json& m, const char* field, std::string& path) {
+    if (!m.is_object() || !m.contains("path")) return m;
+    path = str_at(m, "path", src, std::string(field) + ".path");
+    if (path.empty()) throw InputError(src, std::string(field) + ".path", "must not be empty (omit it for a built-in manifest)");
+    json rest = m;
+    rest.erase("path");
+    return rest;
+  };
+  const json split = without_path(j.at("split"), "split", job.split.path);
   check_keys(split, {"contracts", "name", "sha256"}, src, "split");
   job.split.name = str_at(split, "name", src, "split.name");
   job.split.sha256 = str_at(split, "sha256", src, "split.sha256");
@@ -245,10 +267,11 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
   check_keys(backbone, {"name", "sha256"}, src, "backbone");
   job.backbone.name = str_at(backbone, "name", src, "backbone.name");
   job.backbone.sha256 = str_at(backbone, "sha256", src, "backbone.sha256");
-  const json& pool = j.at("pool");
-  if (!pool.is_null()) {
+  if (!j.at("pool").is_null()) {
+    std::string pool_path;
+    const json pool = without_path(j.at("pool"), "pool", pool_path);
     check_keys(pool, {"name", "sha256"}, src, "pool");
-    job.pool = PoolRef{str_at(pool, "name", src, "pool.name"), str_at(pool, "sha256", src, "pool.sha256")};
+    job.pool = PoolRef{str_at(pool, "name", src, "pool.name"), str_at(pool, "sha256", src, "pool.sha256"), pool_path};
   }
   const json& cal = j.at("calibration_sha256");
   if (!cal.is_null()) job.calibration_sha256 = str_at(j, "calibration_sha256", src, "calibration_sha256");

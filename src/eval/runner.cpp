@@ -135,13 +135,16 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
   result.episodes_total = job.episodes;
   result.episodes_before = store.episodes_done();
 
-  // a finished job is a no-op; only a missing summary (killed before writing it) is restored
+  // a finished job is a no-op (its summary, when it has one, matched its records when the store was
+  // opened); only a summary that is missing (killed before writing it), covers fewer records, or has no
+  // records hash (schema 1.0) is written again
   if (store.complete()) {
     result.already_complete = true;
-    if (!std::filesystem::exists(store.summary_path()))
+    if (!store.summarized() || *store.summarized() < store.episodes_done())
       write_json_atomic(store.summary_path(),
                         make_job_summary(job, store.records(), 0, seconds_since(t0),
-                                         "complete: " + std::to_string(job.episodes) + " episodes (summary restored)"));
+                                         "complete: " + std::to_string(job.episodes) + " episodes (summary restored)",
+                                         store.records_sha256()));
     result.wall_time_s = seconds_since(t0);
     return result;
   }
@@ -275,8 +278,8 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
     // the first error is the one reported: on a full disk the summary cannot be written either,
     // and its error would hide the JSONL append that failed first
     try {
-      write_json_atomic(store.summary_path(),
-                        make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
+      write_json_atomic(store.summary_path(), make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s,
+                                                               message, store.records_sha256()));
     } catch (const std::exception& e) {
       log << "\nactionshift: note: job summary not written either (" << e.what() << ")\n";
     }
@@ -285,7 +288,7 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
     std::rethrow_exception(failure);
   }
   write_json_atomic(store.summary_path(),
-                    make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message));
+                    make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s, message, store.records_sha256()));
   progress.finish(store.episodes_done());
   return result;
 }

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -46,19 +47,25 @@ ResultSet load_results(const std::string& dir) {
   std::set<std::pair<std::string, std::string>> overlapping;   // (kept file, skipped file)
   std::map<std::pair<std::string, std::int64_t>, std::string> where;  // (job id, episode index) → file
   for (const auto& f : out.files) {
+    // a job's summary vouches for its records: read first (a running job only appends after it), it
+    // must be a summary of this job, and the records it covers must hash as it says. A summary that
+    // is truncated, corrupt or of another job, or records edited after it, are errors, never skipped.
+    // A FIFO or device named like a summary must not block or stream: read_file refuses it
+    std::optional<CheckedSummary> summary;
+    const fs::path summary_path = fs::path(f).replace_extension(".summary.json");
+    if (fs::symlink_status(summary_path, ec).type() != fs::file_type::not_found)
+      summary = parse_job_summary(detail::read_file(summary_path.string()), summary_path.string(), fs::path(f).stem().string());
+    std::string bytes;
+    if (summary) {
+      bytes = detail::read_file(f);
+      check_records_hash(*summary, f, bytes);
+    }
     RecordFile rf = read_record_file(f, /*allow_torn_tail=*/true);
     if (rf.torn_tail) out.notes.push_back(f + ": ignored an unterminated last line (job running or killed)");
     std::string family;
-    const fs::path summary = fs::path(f).replace_extension(".summary.json");
-    if (fs::exists(summary, ec)) {
-      try {
-        // a FIFO or device named like a summary must not block or stream: read_file refuses it
-        const JobSpec job = job_from_json(parse_json_input(detail::read_file(summary.string()), summary.string()).at("job"),
-                                          summary.string());
-        if (job_id(job) == fs::path(f).stem().string()) family = family_key(job);
-      } catch (const std::exception&) {
-        family.clear();  // no usable summary: the job's records stand alone
-      }
+    if (summary) {
+      check_records_against_summary(*summary, f, bytes, rf.records);
+      family = family_key(summary->job);
     }
     for (auto& r : rf.records) {
       // the same record in two files (a copied .jsonl) would be counted twice by every consumer

@@ -57,7 +57,9 @@ expect_rc 2 "overflowing record"
 expect_one_line_error "overflowing record"
 expect_err ": return: number out of range" "overflowing record names the field"
 expect_err "out of range" "overflowing record says why"
-# a resume repairs a last record that ends in 1e999 (a torn write), with nothing else lost
+# a resume repairs a last record that ends in 1e999 (a torn write), with nothing else lost; a torn write
+# happens before the job's summary is written (a summary covering the record would refuse it as an edit)
+rm "${JL%.jsonl}.summary.json"
 python3 - "$JL" <<'PY'
 import re, sys
 p = sys.argv[1]
@@ -325,11 +327,14 @@ expect_rc 2 "report with a malformed verdict cell"
 expect_one_line_error "report with a malformed verdict cell"
 expect_err "gate1.verdict.json: cells.pick_cube/reference_seen: expected an object" "report with a malformed verdict cell"
 
-# ---- a FIFO named like a job summary beside its records: summarize must not block on it
+# ---- a FIFO named like a job summary beside its records: summarize must not block on it (and, as any
+# summary that is not one, it is refused in one line)
 mkdir -p "$TMP/fifo_sum" && cp "$TMP/clean.jsonl" "$TMP/fifo_sum/"
 mkfifo "$TMP/fifo_sum/$(basename "$TMP/clean.jsonl" .jsonl).summary.json"
 run timeout 20 "$AS" summarize "$TMP/fifo_sum"
-expect_rc 0 "summarize beside a FIFO summary"
+expect_rc 2 "summarize beside a FIFO summary"
+expect_one_line_error "summarize beside a FIFO summary"
+expect_err "not a regular file" "summarize beside a FIFO summary"
 
 # ---- selftest --sim --calibration of another task read the pose at that task's offsets
 run "$AS" selftest --sim --task push_cube --hidden-contract identity \

@@ -160,6 +160,30 @@ TEST(JobSpec, ObsNoiseEntersTheSpecAndTheIdOnlyWhenNonZero) {
   EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: obs_noise: must be")));
 }
 
+TEST(JobSpec, ManifestPathsAreRecordedNotHashed) {
+  JobSpec plain = golden_job();
+  plain.pool = PoolRef{"reference9", std::string(64, 'e')};
+  JobSpec filed = plain;
+  filed.split.path = "/data/my dir/custom-split.json";
+  filed.pool->path = "/data/custom pool.json";
+  // the content hash is the identity: a file of any name or place is the job of the same manifest
+  EXPECT_EQ(job_id(filed), job_id(plain));
+  EXPECT_EQ(job_canonical_json(filed), job_canonical_json(plain));
+  const nlohmann::json j = job_to_json(filed);
+  EXPECT_EQ(j["split"]["path"], "/data/my dir/custom-split.json");
+  EXPECT_EQ(j["pool"]["path"], "/data/custom pool.json");
+  EXPECT_FALSE(job_to_json(plain)["split"].contains("path"));  // built-in splits: the spec is as before
+  EXPECT_FALSE(job_identity_json(filed)["split"].contains("path"));
+  EXPECT_FALSE(job_identity_json(filed)["pool"].contains("path"));
+  EXPECT_EQ(job_from_json(j, "t"), filed);
+  nlohmann::json rel = j;
+  rel["split"]["path"] = "custom-split.json";
+  EXPECT_THAT([&] { job_from_json(rel, "plan.json"); },
+              ThrowsMessage<InputError>(HasSubstr("plan.json: split.path: must be an absolute path")));
+  rel["split"]["path"] = "";
+  EXPECT_THAT([&] { job_from_json(rel, "plan.json"); }, ThrowsMessage<InputError>(HasSubstr("split.path: must not be empty")));
+}
+
 TEST(JobSpec, FileNamesUseTheFullId) {
   const std::string id = job_id(golden_job());
   EXPECT_EQ(jsonl_file_name(id), id + ".jsonl");

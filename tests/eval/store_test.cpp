@@ -1,6 +1,9 @@
 #include "actionshift/eval/store.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/eval/runner.hpp"
+#include "actionshift/eval/summary.hpp"
 #include "actionshift/eval/statistics.hpp"
 #include "fake_episode.hpp"
 
@@ -8,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -179,7 +183,7 @@ TEST_F(StoreTest, SummaryCountsAndIntervals) {
   recs[1].safety_flags = {"workspace_exit"};
   recs[2].safety_flags = {};
   recs[0].safety_flags = {};
-  const auto s = make_job_summary(job, recs, 4, 1.5, "stopped");
+  const auto s = make_job_summary(job, recs, 4, 1.5, "stopped", std::string(64, 'a'));
   EXPECT_EQ(s["episodes_done"], 4);
   EXPECT_EQ(s["episodes_requested"], 6);
   EXPECT_EQ(s["complete"], false);
@@ -195,8 +199,163 @@ TEST_F(StoreTest, SummaryCountsAndIntervals) {
     EXPECT_EQ(s["per_contract"][c]["episodes"], static_cast<std::int64_t>(c) == twice ? 2 : 1) << "contract " << c;
   EXPECT_EQ(s["message"], "stopped");
   EXPECT_EQ(s["job_id"], job_id(job));
-  const auto empty = make_job_summary(job, {}, 0, 0.0, "not run");
+  const auto empty = make_job_summary(job, {}, 0, 0.0, "not run", sha256_hex(""));
   EXPECT_TRUE(empty["success_once"].is_null());
+}
+
+// --- integrity of records and summaries (docs/formats.md §3: records_sha256)
+
+TEST(RecordsSha256, HashesTheFirstNCompleteLines) {
+  EXPECT_EQ(records_sha256("a\nbb\nc", 0), sha256_hex(""));
+  EXPECT_EQ(records_sha256("a\nbb\nc", 1), sha256_hex("a\n"));
+  EXPECT_EQ(records_sha256("a\nbb\nc", 2), sha256_hex("a\nbb\n"));
+  EXPECT_EQ(records_sha256("a\nbb\nc", 3), std::nullopt);  // the third line is not terminated
+}
+
+class IntegrityTest : public StoreTest {
+ protected:
+  RunOptions opts() {
+    RunOptions o;
+    o.out_dir = dir_.string();
+    o.threads = 1;
+    o.progress = ProgressMode::off;
+    std::ostringstream* sink = &log_;
+    o.log = sink;
+    return o;
+  }
+  std::string jsonl(const JobSpec& job) { return (dir_ / jsonl_file_name(job_id(job))).string(); }
+  std::string summary(const JobSpec& job) { return (dir_ / summary_file_name(job_id(job))).string(); }
+  static void write(const std::string& path, const std::string& bytes) {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f << bytes;
+  }
+  std::ostringstream log_;
+};
+
+TEST_F(IntegrityTest, SummaryCarriesTheHashOfTheRecordsBytes) {
+  const JobSpec job = testing::fake_job(7);
+  run_job(job, testing::fake_episode_fn(), opts());
+  const nlohmann::json s = nlohmann::json::parse(slurp(summary(job)));
+  EXPECT_EQ(s["schema_version"], "2.0");
+  EXPECT_EQ(s["records_sha256"], sha256_hex(slurp(jsonl(job))));
+  EXPECT_EQ(load_results(dir_.string()).records.size(), 7u);
+}
+
+TEST_F(IntegrityTest, AnEditedRecordOfAFinishedJobIsRefusedByReadersAndResume) {
+  const JobSpec job = testing::fake_job(6);
+  run_job(job, testing::fake_episode_fn(0), opts());  // no episode succeeds
+  std::string bytes = slurp(jsonl(job));
+  const auto at = bytes.find("\"success_once\":false");
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, 20, "\"success_once\":true ");  // still a valid record: only the hash can tell
+  write(jsonl(job), bytes);
+  const auto refused = HasSubstr("records_sha256: the records do not match the summary's hash");
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(refused));
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(HasSubstr(jsonl(job))));
+  // a re-run must not claim the job complete
+  EXPECT_THAT([&] { run_job(job, testing::fake_episode_fn(0), opts()); }, ThrowsMessage<InputError>(refused));
+}
+
+TEST_F(IntegrityTest, AnEditedLastRecordIsNotCutAwayAsATornWrite) {
+  const JobSpec job = testing::fake_job(4);
+  run_job(job, testing::fake_episode_fn(), opts());
+  std::string bytes = slurp(jsonl(job));
+  bytes[bytes.size() - 3] = '#';  // the last record no longer parses
+  write(jsonl(job), bytes);
+  EXPECT_THAT([&] { ResultStore::open(dir_.string(), job); },
+              ThrowsMessage<InputError>(HasSubstr("the records do not match the summary's hash")));
+  EXPECT_EQ(slurp(jsonl(job)), bytes);  // untouched
+}
+
+TEST_F(IntegrityTest, RemovedRecordsAreRefused) {
+  const JobSpec job = testing::fake_job(5);
+  run_job(job, testing::fake_episode_fn(), opts());
+  std::string bytes = slurp(jsonl(job));
+  bytes.erase(bytes.rfind('\n', bytes.size() - 2) + 1);  // drop the last record whole
+  write(jsonl(job), bytes);
+  EXPECT_THAT([&] { load_results(dir_.string()); },
+              ThrowsMessage<InputError>(HasSubstr("the file holds 4 complete records but " + job_id(job) + ".summary.json covers 5")));
+}
+
+TEST_F(IntegrityTest, TruncatedOrCorruptSummariesAreRefused) {
+  const JobSpec job = testing::fake_job(5);
+  run_job(job, testing::fake_episode_fn(), opts());
+  const std::string good = slurp(summary(job));
+  write(summary(job), good.substr(0, good.size() / 2));
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(HasSubstr(summary(job) + ": ")));
+  EXPECT_THAT([&] { run_job(job, testing::fake_episode_fn(), opts()); }, ThrowsMessage<InputError>(HasSubstr(summary(job))));
+  // a count that is not the records' (the hash still matches: the summary is what was edited)
+  nlohmann::json j = nlohmann::json::parse(good);
+  j["success_once"]["successes"] = j["success_once"]["successes"].get<int>() == 0 ? 1 : 0;
+  write(summary(job), j.dump(2));
+  EXPECT_THAT([&] { load_results(dir_.string()); },
+              ThrowsMessage<InputError>(HasSubstr("success_once.successes: is ")));
+  // a summary of another job under this job's name
+  j = nlohmann::json::parse(good);
+  j["job"]["seed"] = 1;
+  write(summary(job), j.dump(2));
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(HasSubstr("job: is the spec of another job")));
+  j = nlohmann::json::parse(good);
+  j.erase("records_sha256");
+  write(summary(job), j.dump(2));
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(HasSubstr("records_sha256: missing")));
+  write(summary(job), good);
+  EXPECT_EQ(load_results(dir_.string()).records.size(), 5u);
+}
+
+TEST_F(IntegrityTest, RecordsAfterTheSummaryAreReadAndAFinishedJobRewritesAStaleSummary) {
+  const JobSpec job = testing::fake_job(6);
+  std::atomic<int> calls{0};
+  const auto stop_after_3 = [&](const EpisodeTask& t) {
+    if (t.episode_index == 3) throw std::runtime_error("boom");
+    return testing::fake_episode_fn()(t);
+  };
+  EXPECT_THROW(run_job(job, stop_after_3, opts()), std::runtime_error);
+  // the summary covers 3 records; append the other 3 as a run killed before its summary would
+  {
+    auto s = ResultStore::open(dir_.string(), job);
+    EXPECT_EQ(s.summarized(), 3);
+    for (int i = 3; i < 6; ++i) s.append(record(job, i));
+  }
+  EXPECT_EQ(load_results(dir_.string()).records.size(), 6u);  // the first 3 are verified
+  const auto r = run_job(job, testing::fake_episode_fn(), opts());
+  EXPECT_TRUE(r.already_complete);
+  const nlohmann::json s = nlohmann::json::parse(slurp(summary(job)));
+  EXPECT_EQ(s["episodes_done"], 6);
+  EXPECT_EQ(s["records_sha256"], sha256_hex(slurp(jsonl(job))));
+  (void)calls;
+}
+
+TEST_F(IntegrityTest, AVersion1SummaryIsReadByItsCountsAndRewrittenByARerun) {
+  const JobSpec job = testing::fake_job(5);
+  run_job(job, testing::fake_episode_fn(0), opts());  // no episode succeeds
+  nlohmann::json j = nlohmann::json::parse(slurp(summary(job)));
+  j.erase("records_sha256");
+  j["schema_version"] = "1.0";
+  write(summary(job), j.dump(2));
+  EXPECT_EQ(load_results(dir_.string()).records.size(), 5u);
+  // its counts are still checked: a flipped success is caught
+  const std::string bytes = slurp(jsonl(job));
+  std::string edited = bytes;
+  edited.replace(edited.find("\"success_once\":false"), 20, "\"success_once\":true ");
+  write(jsonl(job), edited);
+  EXPECT_THAT([&] { load_results(dir_.string()); }, ThrowsMessage<InputError>(HasSubstr("the records do not match the summary")));
+  write(jsonl(job), bytes);
+  EXPECT_TRUE(run_job(job, testing::fake_episode_fn(), opts()).already_complete);
+  EXPECT_EQ(nlohmann::json::parse(slurp(summary(job)))["schema_version"], "2.0");
+}
+
+TEST_F(IntegrityTest, ASiblingWithEditedRecordsIsNotAdopted) {
+  const JobSpec small = testing::fake_job(4);
+  run_job(small, testing::fake_episode_fn(0), opts());
+  std::string bytes = slurp(jsonl(small));
+  bytes.replace(bytes.find("\"success_once\":false"), 20, "\"success_once\":true ");
+  write(jsonl(small), bytes);
+  JobSpec big = small;
+  big.episodes = 6;
+  const auto r = run_job(big, testing::fake_episode_fn(0), opts());
+  EXPECT_EQ(r.episodes_run, 6);  // nothing copied from the edited sibling
+  EXPECT_EQ(slurp(jsonl(big)).find("\"success_once\":true"), std::string::npos);
 }
 
 }  // namespace

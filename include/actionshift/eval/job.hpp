@@ -23,11 +23,14 @@ namespace actionshift::eval {
 /// with per-contract initial states, which let a first observation identify the hidden contract.
 inline constexpr std::string_view kJobSchemaVersion = "3.0";
 
-/// A split manifest by name and content hash, with the number of evaluation contracts it holds.
+/// A split manifest by content hash, with the number of evaluation contracts it holds. Its identity is
+/// the hash; the name is a label (records and summary cells carry it). A split given as a file has its
+/// path recorded, not hashed (like RobotRef::urdf): the job is resolved from that file, not by name.
 struct SplitRef {
-  std::string name;             ///< e.g. "seen"
+  std::string name;             ///< e.g. "seen" (the manifest's own name)
   std::string sha256;           ///< 64-hex manifest hash (`manifest_sha256`)
   std::int64_t contracts{0};    ///< number of evaluation contracts (> 0)
+  std::string path{};           ///< absolute manifest file the job was made from; empty: the built-in `name`
   bool operator==(const SplitRef&) const = default;
 };
 
@@ -38,10 +41,12 @@ struct BackboneRef {
   bool operator==(const BackboneRef&) const = default;
 };
 
-/// A declared contract pool by name and content hash (pool-privileged methods only).
+/// A declared contract pool by content hash (pool-privileged methods only); the name is a label and a
+/// pool given as a file has its path recorded, not hashed (as SplitRef).
 struct PoolRef {
   std::string name;             ///< e.g. "reference9"
   std::string sha256;           ///< 64-hex `pool_sha256`
+  std::string path{};           ///< absolute manifest file the job was made from; empty: the built-in `name`
   bool operator==(const PoolRef&) const = default;
 };
 
@@ -121,11 +126,13 @@ void validate_job(const JobSpec& job, const std::string& source = "job");
 /// "method":{"name","params"} (plus "plugin":{"files","kind","rung","sha256","version"} for a user method),"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
 /// "seed","split":{"contracts","name","sha256"},"task"}, plus "robot":{"packages","sha256","urdf"}
 /// only when the job names a robot, "policy_files":{"paths","sha256"} only when it names policy
-/// files, and "obs_noise" (a float) only when it is non-zero. Validates first.
+/// files, "obs_noise" (a float) only when it is non-zero, and "path" in "split" / "pool" only when the
+/// manifest was given as a file. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 
-/// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"} and the method
-/// plug-in's "files" left out (paths are not identity).
+/// The identity object: job_to_json with "robot" and "policy_files" reduced to {"sha256"}, without
+/// "split.path" / "pool.path" (a split's identity is its manifest_sha256) and without the method plug-in's
+/// "files" (paths are not identity).
 nlohmann::json job_identity_json(const JobSpec& job);
 
 /// Canonical JSON text of job_identity_json (sorted keys, no whitespace, Python-repr floats).
