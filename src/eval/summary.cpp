@@ -53,7 +53,7 @@ ResultSet load_results(const std::string& dir) {
     if (fs::exists(summary, ec)) {
       try {
         // a FIFO or device named like a summary must not block or stream: read_file refuses it
-        const JobSpec job = job_from_json(parse_json_input(detail::read_file(summary.string()), summary.string()).at("job"),
+        const JobSpec job = job_from_json(parse_json_input(detail::read_file(summary.string(), "a job summary", kMaxJsonDocumentBytes), summary.string()).at("job"),
                                           summary.string());
         if (job_id(job) == fs::path(f).stem().string()) family = family_key(job);
       } catch (const std::exception&) {
