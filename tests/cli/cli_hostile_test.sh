@@ -125,7 +125,7 @@ python3 - "$TMP/grid.yaml" <<'PY'
 import sys
 seeds = ', '.join(str(s) for s in range(10001))
 open(sys.argv[1], 'w').write('name: grid\ntasks: [pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side]\n'
-                             'splits: [seen, unseen]\nmethods: [oracle]\nseeds: [' + seeds + ']\nepisodes: 1\nbackbone: expert\n')
+                             'splits: [seen, unseen_value]\nmethods: [oracle]\nseeds: [' + seeds + ']\nepisodes: 1\nbackbone: expert\n')
 PY
 run timeout 20 "$AS" plan --experiment "$TMP/grid.yaml" --out "$TMP/gridplan"
 expect_rc 2 "experiment of 100,010 jobs"
