@@ -1,7 +1,8 @@
 // A small stand-in for libFuzzer's driver, so every fuzz target also runs in the normal (GCC) build
 // and its test suite: `fuzz_<target>_replay [-seconds=S] [-seed=N] FILE|DIR...`
 //  1. runs each corpus file as is, and hostile variants of it (wrapped in 100,000 brackets, numbers
-//     replaced by 1e999 and -1e30, cut in half, NUL bytes inserted);
+//     replaced by 1e999 and -1e30, cut in half, NUL bytes inserted) and, for three of them, after an
+//     object's 50,000 distinct keys (each under a 10 s bound);
 //  2. then, for S seconds (default 2), random mutations of random corpus entries (bit flips, byte
 //     insertions and deletions, repeated slices, splices of two entries, interesting tokens).
 // It is not coverage-guided (use the libFuzzer build, scripts/fuzz, for that); it catches
@@ -86,6 +87,29 @@ int main(int argc, char** argv) {
                                  c.substr(0, c.size() / 3) + std::string(1, '\0') + c.substr(c.size() / 3)}) {
       run(v);
       ++executions;
+    }
+  }
+  // an object of 50,000 distinct keys (with the entry's own fields after them, and then a repeat of
+  // the first key), each under a time bound: a duplicate-key check that compares every key with all
+  // before it takes minutes here (1.25e9 comparisons), one hash set per object milliseconds
+  constexpr int kManyKeys = 50000;
+  constexpr double kManyKeysSeconds = 10.0;
+  std::string keys = "{";
+  for (int k = 0; k < kManyKeys; ++k) keys += "\"k" + std::to_string(k) + "\":0,";
+  std::vector<std::string> many = {keys + "\"k0\":1}"};
+  for (std::size_t i = 0; i < corpus.size() && i < 3; ++i) {  // three seeds: each costs a 600 KB parse
+    const std::string& c = corpus[i];
+    many.push_back(keys + (!c.empty() && c.front() == '{' ? c.substr(1) : "\"x\":" + c + "}"));
+  }
+  for (const std::string& v : many) {
+    const auto start = std::chrono::steady_clock::now();
+    run(v);
+    ++executions;
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (took > kManyKeysSeconds) {
+      std::fprintf(stderr, "finding: an object of %d keys took %.1f s (more than %.0f s: quadratic in its keys?)\n", kManyKeys, took,
+                   kManyKeysSeconds);
+      std::abort();
     }
   }
   static const char* kTokens[] = {"[", "]", "{", "}", "\"", ":", ",", "1e999", "-1e999", "1e30", "NaN", "nan", "-0",

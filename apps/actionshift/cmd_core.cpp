@@ -23,23 +23,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_file(const std::string& path) {
-  require_regular_file(path, "an input file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_file(const std::string& path) { return read_input_file(path, "a contract input file", kMaxJsonDocumentBytes); }
 
 // input lines: an inline JSON argument, a file, or stdin
 std::vector<std::pair<std::string, std::string>> input_lines(const std::string& input) {
   std::string text, source;
   if (input.empty() || input == "-") {
-    std::stringstream ss;
-    ss << std::cin.rdbuf();
-    text = ss.str();
     source = "<stdin>";
+    text = read_input_stdin(source, "contract input", kMaxJsonDocumentBytes);
   } else if (!input.empty() && (input.front() == '{' || input.front() == '[')) {
     text = input;
     source = "<argument>";

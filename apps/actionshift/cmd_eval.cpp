@@ -46,12 +46,7 @@ int guarded(std::ostream& err, F&& body) {
 }
 
 json read_json_file(const std::string& path) {
-  require_regular_file(path, "a JSON file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_json_input(ss.str(), path);
+  return parse_json_input(read_input_file(path, "a JSON file", kMaxJsonDocumentBytes), path);
 }
 
 void ensure_parent(const std::string& path) {

@@ -156,6 +156,7 @@ int run_report(const ReportOptions& o) {
       lo.out_dir = o.out_dir;
       lo.reference = o.reference;
       lo.common_episodes = o.common_episodes;
+      lo.splits = o.splits;
       lo.command = o.command;
       const render::LeaderboardResult r = render::write_leaderboard(lo);
       std::cout << "leaderboard: " << r.markdown_path << ", " << r.html_path << " and " << r.json_path << " ("
@@ -164,8 +165,9 @@ int run_report(const ReportOptions& o) {
     }
     if (o.results_dirs.size() != 1)
       throw InputError("report", "results", "give one results directory (several only with --leaderboard)");
-    if (o.reference != "entropy_probes" || o.common_episodes)
-      throw InputError("report", o.common_episodes ? "--common-episodes" : "--reference", "applies to --leaderboard only");
+    if (o.reference != "entropy_probes" || o.common_episodes || !o.splits.empty())
+      throw InputError("report", o.common_episodes ? "--common-episodes" : !o.splits.empty() ? "--splits" : "--reference",
+                       "applies to --leaderboard only");
     const render::ReportResult r = render::write_report(o.results_dirs.front(), o.out_dir);
     std::cout << "report: " << r.html_path << " and " << r.markdown_path << " (" << counted(r.figures.size(), "figure") << ", "
               << r.summaries << " job summaries)\n";

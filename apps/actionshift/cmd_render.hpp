@@ -48,6 +48,7 @@ struct ReportOptions {
   bool leaderboard{false};
   std::string reference{"entropy_probes"};
   bool common_episodes{false};
+  std::vector<std::string> splits;  ///< --leaderboard: only these splits
   std::string command;  ///< the command line, printed on the leaderboard page
 };
 int run_report(const ReportOptions& o);

@@ -7,6 +7,8 @@
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
+#include "actionshift/eval/calibrate.hpp"
+#include "actionshift/sim/task.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/synthetic_robot.hpp"
@@ -34,14 +36,7 @@ namespace actionshift::cli {
 
 namespace {
 
-std::string read_text(const std::string& path) {
-  require_regular_file(path, "a file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(path, "", "cannot read file");
-  return s.str();
-}
+std::string read_text(const std::string& path, const std::string& what) { return read_input_file(path, what, kMaxSmallFileBytes); }
 
 std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
   std::vector<Contract> pool;
@@ -59,8 +54,12 @@ std::vector<Contract> resolve_pool(const std::vector<std::string>& names) {
 }
 
 adapt::ResponseCalibration load_calibration(const SelftestOptions& o) {
-  if (!o.calibration.empty())
-    return adapt::ResponseCalibration::load_for(o.calibration, o.task, "--task " + o.task, o.profile, "--profile " + o.profile);
+  if (!o.calibration.empty()) {
+    auto cal = adapt::ResponseCalibration::load_for(o.calibration, o.task, "--task " + o.task, o.profile, "--profile " + o.profile);
+    // the same checks as `run --calibration`: a layout `run` refuses is refused here too
+    eval::check_calibration_layout(cal, sim::observation_layout(sim::parse_task(o.task)), o.task, o.calibration);
+    return cal;
+  }
   if (auto text = data::builtin_selftest_calibration_text(o.task, o.profile))
     return adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/selftest/" + o.task);
   throw InputError("", "--calibration",
@@ -153,7 +152,7 @@ int calibrate_misspec(const SelftestOptions& o, const selftest::Options& base, c
   }
   nlohmann::json all = nlohmann::json::object();
   std::error_code ec;
-  if (std::filesystem::is_regular_file(o.calibrate_misspec, ec)) all = parse_json_input(read_text(o.calibrate_misspec), o.calibrate_misspec);
+  if (std::filesystem::is_regular_file(o.calibrate_misspec, ec)) all = parse_json_input(read_text(o.calibrate_misspec, "a misspecification file"), o.calibrate_misspec);
   if (!all.is_object()) throw InputError(o.calibrate_misspec, "", "expected a JSON object of tasks");
   all[o.task] = entry;
   const std::string tmp = o.calibrate_misspec + ".tmp";
@@ -306,7 +305,7 @@ Contract resolve_contract_arg(const std::string& arg, const std::string& option)
   }
   std::error_code ec;
   const bool is_file = arg.find('{') == std::string::npos && std::filesystem::is_regular_file(arg, ec);
-  const std::string text = is_file ? read_text(arg) : arg;
+  const std::string text = is_file ? read_text(arg, "a contract file") : arg;
   if (!is_file && arg.find('{') == std::string::npos)
     throw InputError("", option,
                      quote_input(arg) + " is not a library name (" + selftest::named_contract_list() +

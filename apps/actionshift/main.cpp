@@ -18,6 +18,8 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
@@ -51,6 +53,10 @@ const CLI::Validator kSeed(
     },
     "SEED");
 
+// an empty value given on purpose ('' from a script's unset variable) is named as such, not read as
+// "absent" (`contract hash ''` read stdin, `--task ''` said --task was missing) or as a nameless path
+const CLI::Validator kNotEmpty([](std::string& s) { return s.empty() ? std::string("must not be empty") : std::string(); }, "");
+
 // CLI::Range lets NaN through (every comparison with it is false)
 const CLI::Validator kNotNan(
     [](std::string& s) -> std::string {
@@ -70,6 +76,47 @@ const CLI::Validator kProfile(
       return "unknown fidelity profile " + quote_input(s) + " (known: " + known + ")";
     },
     "PROFILE");
+
+// CLI11 converts integers with strtoll/strtoull in base 0: 99999999999999999999 saturates to
+// 2**63 - 1 (or 2**64 - 1) without an error, "010" is octal 8 and "0x10" is 16. Every integer option
+// gets this check first: decimal digits (an optional sign) that fit 64 bits, rewritten without
+// leading zeros so CLI11's own conversion reads them as decimal; CLI11 then checks the option's width.
+CLI::Validator decimal_integer(bool is_unsigned) {
+  return CLI::Validator(
+      [is_unsigned](std::string& s) -> std::string {
+        const std::string shown = quote_input(s);
+        const char* p = s.data();
+        const char* const end = s.data() + s.size();
+        const bool negative = p != end && *p == '-';
+        if (p != end && (*p == '+' || *p == '-')) ++p;
+        const bool digits = p != end && std::all_of(p, end, [](char c) { return c >= '0' && c <= '9'; });
+        if (is_unsigned) {
+          std::uint64_t v = 0;
+          if (!digits || negative || std::from_chars(p, end, v).ec != std::errc())
+            return "must be an integer in [0, 2**64) (got " + shown + ")";
+          s = std::to_string(v);
+          return {};
+        }
+        if (!digits) return "expected a decimal integer (got " + shown + ")";
+        std::uint64_t magnitude = 0;
+        const std::uint64_t limit = negative ? std::uint64_t{1} << 63 : (std::uint64_t{1} << 63) - 1;
+        if (std::from_chars(p, end, magnitude).ec != std::errc() || magnitude > limit)
+          return "out of range: " + shown + " does not fit a 64-bit integer";
+        s = (negative ? "-" : "") + std::to_string(magnitude);
+        return {};
+      },
+      "");
+}
+
+// every integer option of `app` and its subcommands gets decimal_integer (run before parsing)
+void check_integer_options(CLI::App* app) {
+  for (CLI::Option* opt : app->get_options()) {
+    const std::string type = opt->get_type_name();
+    if (type.rfind("UINT", 0) == 0) opt->transform(decimal_integer(true));  // transform: runs first, may rewrite
+    else if (type.rfind("INT", 0) == 0) opt->transform(decimal_integer(false));
+  }
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) check_integer_options(sub);
+}
 
 // Levenshtein distance, for "did you mean" (command names are a few bytes)
 std::size_t edit_distance(std::string_view a, std::string_view b) {
@@ -157,12 +204,14 @@ int main(int argc, char** argv) {
   std::string method_list;  // the registry's names, so the help cannot fall behind it
   for (const std::string& m : adapt::method_names()) method_list += (method_list.empty() ? "" : ", ") + m;
   const auto add_job_options = [&](CLI::App* cmd, cli::CliJobOptions& j, bool required) {
-    auto* task = cmd->add_option("--task", j.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side");
-    auto* split = cmd->add_option("--split", j.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file");
+    auto* task = cmd->add_option("--task", j.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->check(kNotEmpty);
+    auto* split = cmd->add_option("--split", j.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file")
+                      ->check(kNotEmpty);
     auto* method = cmd->add_option("--method", j.request.method.name,
                                    "Adapter method (docs/adapters.md): " + method_list +
                                        ". A bare name runs the paper's method; a variant is NAME{VARIANT} or NAME{KEY=VALUE,...} "
-                                       "(quote it for the shell), e.g. 'entropy_probes{calibrated}'");
+                                       "(quote it for the shell), e.g. 'entropy_probes{calibrated}'")
+                       ->check(kNotEmpty);
     if (required) {
       task->required();
       split->required();
@@ -208,7 +257,7 @@ int main(int argc, char** argv) {
       "validate",
       "Validate split manifests and pools: recompute every hash, check grammar coverage, the split\n"
       "rules' disjointness and regeneration from (rule, seed); print one line per check and a summary.");
-  validate->add_option("paths", validate_o.paths, "Manifest files or directories (default: the built-in manifests)");
+  validate->add_option("paths", validate_o.paths, "Manifest files or directories (default: the built-in manifests)")->check(kNotEmpty);
   validate->add_flag("-q,--quiet", validate_o.quiet, "Print only failed checks and the summary table");
   validate->add_flag("--json", validate_o.json, "Print one JSON report instead of text");
   validate->callback([&] { action = [&] { return cli::run_validate(validate_o); }; });
@@ -218,7 +267,7 @@ int main(int argc, char** argv) {
   contract->require_subcommand(1);
   cli::ContractOptions contract_o;
   auto add_input = [&](CLI::App* c) {
-    c->add_option("input", contract_o.input, "JSON text, a file of JSON lines, or - for stdin (default: stdin)");
+    c->add_option("input", contract_o.input, "JSON text, a file of JSON lines, or - for stdin (default: stdin)")->check(kNotEmpty);
   };
   auto* hash = contract->add_subcommand(
       "hash", "Print {sha256, canonical, composition} for a contract object (bare or as {\"contract\": ...})");
@@ -470,8 +519,8 @@ int main(int argc, char** argv) {
       "one resumes. Ctrl-C or SIGTERM stops it after the episodes already finished (exit 130; a second\n"
       "signal ends it at once). Either --task/--split/--method/--seed, or --plan FILE [--job-index I].");
   add_job_options(run, run_o.job, /*required=*/false);
-  run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead");
-  run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)")
+  run->add_option("--plan", run_o.run.plan_file, "Run the jobs of a plan file (actionshift plan) instead")->check(kNotEmpty);
+  auto* job_index = run->add_option("--job-index", run_job_index, "With --plan: only this job (a Slurm array task id)")
       ->check(CLI::Validator(
           [](std::string& v) { return !v.empty() && v[0] == '-' ? "must be a job index >= 0 (got " + v + ")" : std::string(); }, ""));
   run->add_option("--out", run_o.run.out_dir, "Results directory")->capture_default_str();
@@ -485,6 +534,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->callback([&] {
     action = [&] {
+      if (job_index->count() > 0 && run_o.run.plan_file.empty()) {  // was ignored: the single job ran
+        std::cerr << "actionshift: error: --job-index: only applies with --plan (see --help)\n";
+        return static_cast<int>(cli::kBadInput);
+      }
       if (run_job_index >= 0) run_o.run.job_index = run_job_index;
       if (run_o.run.plan_file.empty() &&
           (run_o.job.request.task.empty() || run_o.job.request.split.empty() || run_o.job.request.method.name.empty())) {
@@ -502,7 +555,7 @@ int main(int argc, char** argv) {
               "(summarize, and gate1 when the plan has oracle and no_adapt) and <name>.submit.sh, which submits the arrays in\n"
               "chunks under the cluster's MaxArraySize and the merge job with --dependency=afterok. Every path in them is\n"
               "absolute, so `bash <name>.submit.sh` works from any directory.");
-  plan->add_option("--experiment", plan_o.experiment_file, "Experiment YAML")->required();
+  plan->add_option("--experiment", plan_o.experiment_file, "Experiment YAML")->required()->check(kNotEmpty);
   plan->add_option("--out", plan_o.out_dir, "Results directory of the jobs")->capture_default_str();
   plan->add_option("--plan", plan_o.plan_file, "Plan file (default <out>/<experiment>.plan.json)");
   plan->add_flag("--slurm", plan_o.slurm, "Also write a Slurm array script");
@@ -527,7 +580,7 @@ int main(int argc, char** argv) {
 
   cli::SummarizeOptions sum_o;
   auto* summarize = app.add_subcommand("summarize", "Merge every <id>.jsonl in a directory into per-cell tables (Markdown or JSON)");
-  summarize->add_option("dir", sum_o.results_dir, "Results directory")->required();
+  summarize->add_option("dir", sum_o.results_dir, "Results directory")->required()->check(kNotEmpty);
   summarize->add_flag("--json", sum_o.json, "Print JSON instead of Markdown");
   summarize->add_option("--out", sum_o.out_file, "Also write the JSON summary to this file");
   summarize->callback([&] { action = [&] { return cli::run_summarize(sum_o); }; });
@@ -602,7 +655,9 @@ int main(int argc, char** argv) {
                         "episodes (task episodes with resets, capped at the horizon)")
       ->capture_default_str();
   calibrate->add_option("--episodes", cal_o.episodes, "Random walks (maniskill_walk, reference_walk) or episodes; 1 to 100000")->check(CLI::Range(1, 100000))->capture_default_str();
-  calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode")->capture_default_str();
+  calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode (at least 2: a response needs two poses)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000000));
   calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
   calibrate->add_option("--drive", cal_o.drive, "Ablation: override the arm drive: implicit_pd or velocity_servo");
   calibrate->add_option("--solver-iterations", cal_o.solver_iterations,
@@ -672,6 +727,8 @@ int main(int argc, char** argv) {
                    "the paired bootstrap difference and the promotion verdict; a method of your own is one more row");
   report->add_option("--reference", report_o.reference, "--leaderboard: the method every row is compared with")
       ->capture_default_str();
+  report->add_option("--splits", report_o.splits, "--leaderboard: only these splits' cells (default: every split)")
+      ->delimiter(',');
   report->add_flag("--common-episodes", report_o.common_episodes,
                    "--leaderboard: pair only the episodes both cells hold (as `compare --common-episodes`)");
   report->callback([&] {
@@ -683,6 +740,7 @@ int main(int argc, char** argv) {
     std::cerr << "actionshift: error: " << unknown << " (see --help)\n";
     return cli::kBadInput;
   }
+  check_integer_options(&app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -80,6 +80,22 @@ void castable(py::handle h) {
   (void)h.cast<T>();
 }
 
+// A Python int that a failed conversion could not hold, as text (cut): `h` itself when the
+// parameter takes one number (pybind11's int and float casters fail on an int only when it is out of
+// the C type's range), or an element of a list or tuple `h` beyond 64 bits
+std::optional<std::string> int_out_of_range(py::handle h, bool scalar_number) {
+  const auto is_int = [](py::handle x) { return PyLong_Check(x.ptr()) && !PyBool_Check(x.ptr()); };
+  if (is_int(h)) return scalar_number ? std::optional<std::string>(printable_input(std::string(py::str(h)), 40)) : std::nullopt;
+  if (PyList_Check(h.ptr()) || PyTuple_Check(h.ptr()))
+    for (py::handle x : h) {
+      if (!is_int(x)) continue;
+      int overflow = 0;
+      (void)PyLong_AsLongLongAndOverflow(x.ptr(), &overflow);
+      if (overflow != 0) return printable_input(std::string(py::str(x)), 40);
+    }
+  return std::nullopt;
+}
+
 // The arguments of a keyword constructor's catch-all overload (`*args, **kwargs`), bound to its
 // parameters in order, defaults filled in and every given value checked. pybind11 answers a call
 // that matches no signature with a TypeError of several lines (every signature, then the
@@ -114,6 +130,11 @@ std::vector<py::object> bind_call(const char* callee, const std::vector<CallPara
     try {
       params[k].check(values[k]);
     } catch (const py::cast_error&) {
+      // an int is the right type but may not fit: say so, not "expected an int (got int)"
+      const std::string_view expected = params[k].expected;
+      if (const auto big = int_out_of_range(values[k], expected.starts_with("an int") || expected.starts_with("a number")))
+        throw InputError(std::string(callee) + "()", params[k].name, "out of range: " + *big + " is too large in magnitude (expected " +
+                                                                             params[k].expected + ")");
       throw py::type_error(who + params[k].name + ": expected " + params[k].expected + " (got " +
                            Py_TYPE(values[k].ptr())->tp_name + ")");
     }
@@ -1065,11 +1086,7 @@ std::unique_ptr<adapt::Adapter> make_adapter(const std::string& label, const std
       h.model = adapt::ResponseCalibration::from_json(py_to_json(calibration, "calibration"), "calibration").model();
     } else {  // a calibration file
       const std::string path = py::str(py::module_::import("os").attr("fspath")(calibration)).cast<std::string>();
-      std::ifstream f(path, std::ios::binary);
-      if (!f) throw InputError(path, "", "cannot read calibration file");
-      std::stringstream ss;
-      ss << f.rdbuf();
-      h.model = adapt::ResponseCalibration::from_json(ss.str(), path).model();
+      h.model = adapt::ResponseCalibration::load(path).model();
     }
     in.model = &*h.model;
   } else if (!calibration.is_none()) {

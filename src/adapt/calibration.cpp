@@ -177,12 +177,7 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
 }
 
 ResponseCalibration ResponseCalibration::load(const std::string& path) {
-  require_regular_file(path, "a calibration file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return from_json(ss.str(), path);
+  return from_json(read_input_file(path, "a calibration file", kMaxSmallFileBytes), path);
 }
 
 ResponseCalibration ResponseCalibration::load_for(const std::string& path, const std::string& task, const std::string& task_name,

@@ -328,7 +328,7 @@ std::shared_ptr<const IdentifierWeights> load_identifier_cached(const std::strin
   const std::filesystem::path sums = p.parent_path() / "SHA256SUMS";
   std::error_code ec;
   if (std::filesystem::is_regular_file(sums, ec)) {
-    std::ifstream in(sums);
+    std::istringstream in(read_input_file(sums.string(), "a SHA256SUMS file", kMaxSmallFileBytes));
     std::string line;
     while (std::getline(in, line)) {
       std::istringstream ls(line);

@@ -81,6 +81,8 @@ Manifest resolve_manifest(const std::string& name_or_path) {
     return m;
   }
   if (auto text = builtin_manifest_text(name_or_path)) return Manifest::parse(*text, "builtin:" + name_or_path);
+  // a directory, device or FIFO by that name is named as such, not as a missing file
+  if (std::filesystem::exists(std::filesystem::status(name_or_path, ec))) (void)Manifest::load(name_or_path);
   std::string known;
   for (const auto& n : builtin_manifest_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError(name_or_path, "", "no such manifest file and not a built-in name (built-in: " + known + ")");

@@ -1,5 +1,6 @@
 #include "actionshift/eval/calibrate.hpp"
 
+#include "actionshift/core/error.hpp"
 #include "actionshift/core/rng.hpp"
 
 #include <algorithm>
@@ -19,6 +20,18 @@ int finger_start(const sim::ObservationLayout& layout) {
   const sim::ObsField* f = layout.find("qpos");
   if (!f || f->width != 9) throw std::invalid_argument("observation layout has no 9-wide qpos field");
   return f->offset + 7;
+}
+
+void check_calibration_layout(const adapt::ResponseCalibration& cal, const sim::ObservationLayout& layout,
+                              const std::string& task, const std::string& source) {
+  const adapt::TcpSlice slice = tcp_slice(layout);
+  const auto check = [&](const char* field, int is, int want) {
+    if (is != want)
+      throw InputError(source, field, "is " + std::to_string(is) + ", but " + task + "'s observation has it at " + std::to_string(want));
+  };
+  check("position_start", cal.slice.position_start, slice.position_start);
+  check("quaternion_start", cal.slice.quaternion_start, slice.quaternion_start);
+  if (cal.gripper) check("gripper.start", cal.gripper->start, finger_start(layout));
 }
 
 std::string_view protocol_name(CalibrationProtocol p) {

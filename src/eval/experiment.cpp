@@ -358,20 +358,9 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
     if (given_calibration && cal.task != job.task)
       throw InputError(calibration_source, "task", "is " + cal.task + ", not the job's " + job.task);
     const std::string cal_source = given_calibration ? calibration_source : "built-in calibration " + job.task;
-    const auto layout_error = [&](const char* field, int is, int want) {
-      return InputError(cal_source, field,
-                        "is " + std::to_string(is) + ", but " + job.task + "'s observation has it at " + std::to_string(want));
-    };
-    if (cal.slice.position_start != ctx->slice.position_start)
-      throw layout_error("position_start", cal.slice.position_start, ctx->slice.position_start);
-    if (cal.slice.quaternion_start != ctx->slice.quaternion_start)
-      throw layout_error("quaternion_start", cal.slice.quaternion_start, ctx->slice.quaternion_start);
+    check_calibration_layout(cal, ctx->model->layout(), job.task, cal_source);
     ctx->response = cal.model();
-    if (cal.gripper) {
-      if (cal.gripper->start != finger_start(ctx->model->layout()))
-        throw layout_error("gripper.start", cal.gripper->start, finger_start(ctx->model->layout()));
-      ctx->finger_start = cal.gripper->start;
-    }
+    if (cal.gripper) ctx->finger_start = cal.gripper->start;
   }
   if (backbone->name() != job.backbone.name)
     throw InputError("backbone " + backbone->name(), "name", "is not the job's backbone " + job.backbone.name);

@@ -14,18 +14,8 @@
 
 namespace actionshift::eval::detail {
 
-std::string read_file(const std::string& path) {
-  require_regular_file(path, "a file");
-  std::error_code size_ec;
-  const auto size = std::filesystem::file_size(path, size_ec);
-  if (!size_ec && size > kMaxInputFileBytes)
-    throw InputError(path, "", "file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(kMaxInputFileBytes) + ")");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", std::string("cannot open file: ") + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path, "", "read error");
-  return ss.str();
+std::string read_file(const std::string& path, const std::string& what, std::uintmax_t max_bytes) {
+  return read_input_file(path, what, max_bytes);
 }
 
 void atomic_write(const std::string& path, std::string_view bytes) {

@@ -1,14 +1,18 @@
 #pragma once
 // private helpers of the eval layer: whole-file reads, atomic writes, small checks
 
+#include "actionshift/core/input_file.hpp"
+
 #include <cstdint>
 #include <string>
 #include <string_view>
 
 namespace actionshift::eval::detail {
 
-// whole file as bytes; throws InputError(path, "", reason) if it cannot be read
-std::string read_file(const std::string& path);
+// whole file as bytes, at most `max_bytes` (read_input_file: the size is checked before reading);
+// throws InputError(path, "", reason) naming `what` if it cannot be read or is too large
+std::string read_file(const std::string& path, const std::string& what = "an input file",
+                      std::uintmax_t max_bytes = kMaxInputFileBytes);
 
 // write `bytes` to `path` atomically: `<path>.tmp.<pid>` is written, fsynced and renamed over `path`
 void atomic_write(const std::string& path, std::string_view bytes);

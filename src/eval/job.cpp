@@ -292,14 +292,14 @@ std::string files_content_sha256(const std::vector<std::string>& paths, const st
   if (paths.empty()) throw InputError("", field, "name at least one file");
   std::vector<std::string> hashes;
   for (const auto& p : paths) {
-    require_regular_file(p, "a file");
-    std::ifstream in(p, std::ios::binary);
-    std::error_code ec;
-    if (!in || !std::filesystem::is_regular_file(p, ec)) throw InputError(p, field, "cannot read file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw InputError(p, field, "cannot read file");
-    hashes.push_back(sha256_hex(ss.str()));
+    // the whole file or an error: a short or failed read must never be hashed as if it were the file
+    std::string bytes;
+    try {
+      bytes = read_input_file(p, "a policy file", kMaxInputFileBytes);
+    } catch (const InputError& e) {
+      throw InputError(e.source(), field, e.reason());
+    }
+    hashes.push_back(sha256_hex(bytes));
   }
   std::sort(hashes.begin(), hashes.end());
   return sha256_hex(canonical_dump(json(hashes)));

@@ -9,6 +9,7 @@
 #include "io.hpp"
 
 #include <nlohmann/json.hpp>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace actionshift::eval {
 
@@ -171,7 +173,28 @@ void check_json_keys(const json& j, const std::set<std::string>& keys, const std
     if (!j.contains(k)) throw InputError(src, field.empty() ? k : field + "." + k, "missing field");
 }
 
+// refuses an experiment whose grid exceeds kMaxPlanJobs, from the list sizes alone
+void check_job_count(const Experiment& ex) {
+  const std::uint64_t n = experiment_job_count(ex);
+  if (n <= kMaxPlanJobs) return;
+  const std::string count = n == UINT64_MAX ? "more than 2^64" : std::to_string(n);
+  throw InputError(ex.source, "",
+                   "the experiment expands to " + count + " jobs (" + std::to_string(ex.tasks.size()) + " tasks x " +
+                       std::to_string(ex.splits.size()) + " splits x " + std::to_string(ex.methods.size()) + " methods x " +
+                       std::to_string(ex.seeds.size()) + " seeds), at most " + std::to_string(kMaxPlanJobs) +
+                       " in one plan (split it into several experiments)");
+}
+
 }  // namespace
+
+std::uint64_t experiment_job_count(const Experiment& ex) {
+  std::uint64_t n = 1;
+  for (const std::size_t k : {ex.tasks.size(), ex.splits.size(), ex.methods.size(), ex.seeds.size()}) {
+    if (k != 0 && n > UINT64_MAX / k) return UINT64_MAX;
+    n *= k;
+  }
+  return n;
+}
 
 Experiment parse_experiment(std::string_view text, const std::string& source) {
   if (text.size() > kMaxExperimentBytes)
@@ -185,14 +208,27 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
     throw InputError(source + ":" + std::to_string(line), "", "not valid UTF-8 (byte offset " + std::to_string(bad) + ")");
   }
   YAML::Node root;
+  std::vector<YAML::Node> docs;
   try {
-    root = YAML::Load(std::string(text));
+    // every document is parsed: a second one (after `---`) would otherwise be silently ignored
+    docs = YAML::LoadAll(std::string(text));
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp 0.7 gives this exception the message "bad file"
+    const std::string where = e.mark.line >= 0 ? source + ":" + std::to_string(e.mark.line + 1) : source;
+    throw InputError(where, "", "malformed YAML: nested too deeply (yaml-cpp stops at recursion depth " + std::to_string(e.depth()) +
+                                    "; an experiment needs a few levels)");
   } catch (const YAML::Exception& e) {
     const std::string where = e.mark.line >= 0 ? source + ":" + std::to_string(e.mark.line + 1) : source;
     throw InputError(where, "", "malformed YAML: " + e.msg);
   } catch (const std::exception& e) {
     throw InputError(source, "", std::string("malformed YAML: ") + e.what());
   }
+  if (docs.size() > 1) {
+    const auto mark = docs[1].Mark();
+    const std::string where = mark.line >= 0 ? source + ":" + std::to_string(mark.line + 1) : source;
+    throw InputError(where, "", "more than one YAML document (an experiment file holds one; remove the second `---` and what follows)");
+  }
+  if (!docs.empty()) root = docs.front();
   if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
   static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
                                                "seeds",    "episodes",    "backbone", "pool",   "rotation_mode", "profile"};
@@ -280,6 +316,7 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   } else if (root["pool"] && !root["pool"].IsNull()) {
     ex.pool = require_token(root["pool"], source, "pool");
   }
+  check_job_count(ex);
   if (root["rotation_mode"]) {
     ex.rotation_mode = require_string(root["rotation_mode"], source, "rotation_mode");
     if (ex.rotation_mode != "live" && ex.rotation_mode != "identity")
@@ -297,13 +334,8 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
 }
 
 Experiment load_experiment(const std::string& path) {
-  // refuse an oversized file before reading it into memory
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > kMaxExperimentBytes)
-    throw InputError(path, "", "experiment file too large (" + std::to_string(size) + " bytes, at most " +
-                                   std::to_string(kMaxExperimentBytes) + ")");
-  return parse_experiment(detail::read_file(path), path);
+  // an oversized file is refused before it is read
+  return parse_experiment(detail::read_file(path, "an experiment file", kMaxExperimentBytes), path);
 }
 
 JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
@@ -350,6 +382,7 @@ auto in_experiment(const Experiment& ex, const std::string& field, F&& f) -> dec
 Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
   if (!resolver.split || !resolver.backbone) throw std::invalid_argument("make_plan: resolver needs split and backbone");
   if (ex.pool && !resolver.pool) throw InputError(ex.source, "pool", "pools cannot be resolved here");
+  check_job_count(ex);  // before anything is resolved or expanded
   Plan plan;
   plan.experiment = ex.name;
   plan.source = ex.source;
@@ -446,6 +479,8 @@ Plan plan_from_json(const nlohmann::json& j, const std::string& source) {
   plan.source_sha256 = j.at("source_sha256").get<std::string>();
   const json& jobs = j.at("jobs");
   if (!jobs.is_array()) throw InputError(source, "jobs", "expected a list");
+  if (jobs.size() > kMaxPlanJobs)
+    throw InputError(source, "jobs", std::to_string(jobs.size()) + " jobs, at most " + std::to_string(kMaxPlanJobs) + " in one plan");
   if (!j.at("job_count").is_number_integer() || j.at("job_count").get<std::int64_t>() != static_cast<std::int64_t>(jobs.size()))
     throw InputError(source, "job_count", "does not match the number of jobs (" + std::to_string(jobs.size()) + ")");
   for (std::size_t i = 0; i < jobs.size(); ++i) {
@@ -466,7 +501,7 @@ Plan plan_from_json(const nlohmann::json& j, const std::string& source) {
 }
 
 Plan load_plan(const std::string& path) {
-  const std::string text = detail::read_file(path);
+  const std::string text = detail::read_file(path, "a plan file", kMaxInputFileBytes);
   return plan_from_json(parse_json_input(text, path), path);
 }
 

@@ -203,7 +203,7 @@ EpisodeRecord parse_record_line(std::string_view line, const std::string& src) {
 }
 
 RecordFile read_record_file(const std::string& path, bool allow_torn_tail) {
-  const std::string bytes = detail::read_file(path);
+  const std::string bytes = detail::read_file(path, "a results file");
   RecordFile out;
   std::size_t start = 0;
   std::int64_t line_no = 0;

@@ -56,6 +56,14 @@ class Progress {
     show(done, true);
   }
 
+  // ends the bar's unfinished line, if one is on the screen, before a message is written after it
+  // (a newline written without a bar made the first line of a full disk's error report blank)
+  void break_line() {
+    if (!open_line_) return;
+    out_ << "\n";
+    open_line_ = false;
+  }
+
  private:
   void show(std::int64_t done, bool final) {
     const double elapsed = seconds_since(t0_);
@@ -73,6 +81,7 @@ class Progress {
       out_ << "\r" << short_id << " [" << bar << "] " << head
            << (final ? "done in " + detail::format_seconds(elapsed) : "ETA " + detail::format_seconds(eta)) << "   ";
       if (final) out_ << "\n";
+      open_line_ = !final;
       out_.flush();
     } else {
       out_ << "actionshift: job " << short_id << ": " << head
@@ -83,6 +92,7 @@ class Progress {
 
   std::ostream& out_;
   ProgressMode mode_{ProgressMode::off};
+  bool open_line_{false};  // the bar's line has no newline yet
   std::string id_;
   std::int64_t before_, total_;
   Clock::time_point t0_, last_;
@@ -281,9 +291,10 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
       write_json_atomic(store.summary_path(), make_job_summary(job, store.records(), result.episodes_run, result.wall_time_s,
                                                                message, store.records_sha256()));
     } catch (const std::exception& e) {
-      log << "\nactionshift: note: job summary not written either (" << e.what() << ")\n";
+      progress.break_line();
+      log << "actionshift: note: job summary not written either (" << printable_input(e.what(), 500) << ")\n";
     }
-    if (options.progress != ProgressMode::off) log << "\n";
+    progress.break_line();
     if (was_interrupted) throw Interrupted(interrupted_after);
     std::rethrow_exception(failure);
   }

@@ -307,13 +307,15 @@ ResultStore ResultStore::open(const std::string& out_dir, const JobSpec& job, co
       keep_bytes = lines[i].first;
       break;
     }
+    // a complete (newline-terminated) line was written whole by one write(2): if it does not parse,
+    // it is not a torn write but a damaged or edited record, reported and never cut away
     EpisodeRecord r;
     try {
       r = parse_record_line(text, src);
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
       if (!last) throw;
-      keep_bytes = lines[i].first;  // a complete but unparsable last line is a torn write too
-      break;
+      throw InputError(e.source(), e.field(),
+                       e.reason() + " (a complete last line that does not parse is not a torn write; the file is left as it is)");
     }
     check_record_belongs(r, job, s.id_, static_cast<std::int64_t>(i), src);
     if (static_cast<std::int64_t>(i) >= job.episodes)

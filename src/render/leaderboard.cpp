@@ -32,8 +32,6 @@ using nlohmann::json;
 
 using CellId = std::tuple<std::string, std::string, std::string>;  // task, split, backbone
 
-std::string cell_name(const CellId& c) { return std::get<0>(c) + "/" + std::get<1>(c) + " · " + std::get<2>(c); }
-
 std::string r3(double x) { return eval::fixed(x, 3); }
 std::string signed3(double x) { return (x >= 0 ? "+" : "") + eval::fixed(x, 3); }
 
@@ -116,6 +114,7 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
   for (const auto& c : cmp.at("cells")) {
     const CellId id{c.at("task").get<std::string>(), c.at("split").get<std::string>(), c.at("backbone").get<std::string>()};
     if (!ref->second.count(id)) continue;  // the board's cells are the reference's
+    if (!o.splits.empty() && std::find(o.splits.begin(), o.splits.end(), std::get<1>(id)) == o.splits.end()) continue;
     columns.insert(id);
     Row& row = rows[c.at("method").get<std::string>()];
     row.label = c.at("method").get<std::string>();
@@ -123,6 +122,7 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
   }
   for (const auto& k : cmp.at("comparisons")) {
     const CellId id{k.at("task").get<std::string>(), k.at("split").get<std::string>(), k.at("backbone").get<std::string>()};
+    if (!columns.count(id)) continue;
     rows[k.at("candidate").get<std::string>()].comparisons[id] = k;
   }
   std::vector<Row> order;
@@ -138,37 +138,59 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
 
   const eval::Provenance& prov = eval::build_provenance();
   const std::string commit = prov.git_commit.empty() ? "unknown" : prov.git_commit;
+  const std::string command = o.command.empty() ? "actionshift report --leaderboard" : o.command;
+  // the columns grouped: one table per (task, split), a column pair per backbone
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> groups;
+  std::set<std::string> backbones;
+  for (const auto& c : columns) {
+    groups[{std::get<0>(c), std::get<1>(c)}].push_back(std::get<2>(c));
+    backbones.insert(std::get<2>(c));
+  }
+  const auto success_text = [](const json& w) {
+    return r3(w.at("rate").get<double>()) + " [" + r3(w.at("lower").get<double>()) + ", " + r3(w.at("upper").get<double>()) +
+           "] n=" + std::to_string(w.at("total").get<std::int64_t>());
+  };
+  const auto delta_text = [](const json& k) {
+    const json& d = k.at("difference");
+    return signed3(d.at("estimate").get<double>()) + " [" + signed3(d.at("lower").get<double>()) + ", " +
+           signed3(d.at("upper").get<double>()) + "] " + k.at("promotion").at("verdict").get<std::string>();
+  };
+  const auto delta_class = [](const json& k) -> std::string {
+    const json& d = k.at("difference");
+    if (!d.at("excludes_zero").get<bool>()) return "";
+    return d.at("estimate").get<double>() > 0 ? "up" : "down";
+  };
+
   std::ostringstream md, html;
-  md << "# Leaderboard\n\n"
-     << "Every method label of the results, against `" << o.reference << "` on the cells where it ran "
-     << "(task/split · backbone). Per cell: success (`success_once`) with its 95 % Wilson interval and n; "
-     << "Δ: the paired bootstrap difference from `" << o.reference << "` with its 95 % interval over the "
-     << "same episodes (same seed, contract and initial state), and the promotion verdict of "
-     << "`actionshift gate promote`. Rows are sorted by mean success over their cells. A difference whose "
-     << "interval includes 0 does not rank two methods. The intervals treat episodes as independent, but the "
-     << "contracts of one block share their initial state, so they are somewhat too narrow (docs/formats.md, "
-     << "\"Comparison\").\n\n"
-     << "Made by `" << (o.command.empty() ? "actionshift report --leaderboard" : o.command) << "` at commit `" << commit
-     << "` from " << records << " records in " << o.results_dirs.size() << " director" << (o.results_dirs.size() == 1 ? "y" : "ies")
-     << "; profile, seeds and episode counts are each job's (leaderboard.json, `inputs` and the cells' `per_seed`).\n\n";
-  md << "| method | rung | kind |";
-  for (const auto& c : columns) md << " " << md_cell(cell_name(c)) << " | Δ vs " << md_cell(o.reference) << " |";
-  md << "\n|---|---|---|";
-  for (std::size_t i = 0; i < columns.size(); ++i) md << "---|---|";
-  md << "\n";
+  const std::string intro =
+      "Every method label of the results against `" + o.reference + "`, on each (task, split, backbone) where `" + o.reference +
+      "` ran. Success is `success_once` with its 95 % Wilson interval and n; Δ is the paired bootstrap difference from `" +
+      o.reference + "` with its 95 % interval over the same episodes (same seed, contract and initial state), followed by the "
+      "promotion verdict of `actionshift gate promote`. A difference whose interval includes 0 does not rank two methods. The "
+      "intervals treat episodes as independent, but the contracts of one block share their initial state, so they are somewhat "
+      "too narrow (docs/formats.md, \"Comparison\").";
+  md << "# Leaderboard\n\n" << intro << "\n\n"
+     << "Made by `" << command << "` at commit `" << commit << "` from " << records << " records in " << o.results_dirs.size()
+     << " director" << (o.results_dirs.size() == 1 ? "y" : "ies")
+     << "; each job's profile, seeds and episode counts are in leaderboard.json (`comparison.cells[].per_seed`, `jobs`).\n\n";
   html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>ActionShift leaderboard</title><style>"
-       << "body{font-family:sans-serif;margin:2em;max-width:80em}table{border-collapse:collapse}"
+       << "body{font-family:sans-serif;margin:2em;max-width:90em}table{border-collapse:collapse;margin-bottom:1.5em}"
        << "td,th{border:1px solid #ccc;padding:.3em .6em;text-align:right}td:first-child,th:first-child{text-align:left}"
-       << ".ref{background:#eef}.up{color:#060}.down{color:#a00}small{color:#555}</style></head><body>"
-       << "<h1>Leaderboard</h1><p>Every method against <code>" << detail::xml_escape(o.reference)
-       << "</code>: success with its 95&nbsp;% Wilson interval; &Delta;: the paired bootstrap difference with its 95&nbsp;% "
-       << "interval over the same episodes, and the promotion verdict. Sorted by mean success. An interval that includes 0 "
-       << "does not rank two methods.</p><p><small>Made by <code>"
-       << detail::xml_escape(o.command.empty() ? "actionshift report --leaderboard" : o.command) << "</code> at commit <code>"
-       << detail::xml_escape(commit) << "</code> from " << records << " records.</small></p><table><tr><th>method</th><th>rung</th><th>kind</th>";
-  for (const auto& c : columns)
-    html << "<th>" << detail::xml_escape(cell_name(c)) << "</th><th>&Delta; vs " << detail::xml_escape(o.reference) << "</th>";
-  html << "</tr>";
+       << ".ref{background:#eef}.up{color:#060;font-weight:bold}.down{color:#a00;font-weight:bold}small{color:#555}</style></head><body>"
+       << "<h1>Leaderboard</h1><p>" << detail::xml_escape(intro) << "</p><p><small>Made by <code>" << detail::xml_escape(command)
+       << "</code> at commit <code>" << detail::xml_escape(commit) << "</code> from " << records << " records.</small></p>";
+
+  // overall: mean success per backbone and how the paired differences fall
+  md << "## Overall\n\n| method | rung | kind |";
+  html << "<h2>Overall</h2><table><tr><th>method</th><th>rung</th><th>kind</th>";
+  for (const auto& b : backbones) {
+    md << " mean success, " << md_cell(b) << " (cells) |";
+    html << "<th>mean success, " << detail::xml_escape(b) << " (cells)</th>";
+  }
+  md << " Δ vs " << md_cell(o.reference) << ": better / worse / not separated |\n|---|---|---|";
+  html << "<th>&Delta; vs " << detail::xml_escape(o.reference) << ": better / worse / not separated</th></tr>";
+  for (std::size_t i = 0; i < backbones.size(); ++i) md << "---|";
+  md << "---|\n";
   json board = json::array();
   for (const auto& row : order) {
     const bool is_ref = row.label == o.reference;
@@ -177,43 +199,81 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
          << detail::xml_escape(row.rung) << "</td><td>" << detail::xml_escape(row.kind) << "</td>";
     json entry = {{"method", row.label}, {"rung", row.rung}, {"kind", row.kind}, {"mean_success", row.mean_success},
                   {"cells", json::array()}};
-    for (const auto& c : columns) {
-      const auto cell = row.cells.find(c);
-      const auto cmpi = row.comparisons.find(c);
-      std::string s = "–", d = is_ref ? "reference" : "–", hd = d;
-      if (cell != row.cells.end()) {
-        const json& w = cell->second.at("success_once");
-        s = r3(w.at("rate").get<double>()) + " [" + r3(w.at("lower").get<double>()) + ", " + r3(w.at("upper").get<double>()) +
-            "] n=" + std::to_string(w.at("total").get<std::int64_t>());
-      }
-      if (cmpi != row.comparisons.end()) {
-        const json& k = cmpi->second;
-        const json& diff = k.at("difference");
-        const double est = diff.at("estimate").get<double>();
-        d = signed3(est) + " [" + signed3(diff.at("lower").get<double>()) + ", " + signed3(diff.at("upper").get<double>()) + "] " +
-            k.at("promotion").at("verdict").get<std::string>();
-        const bool excl = diff.at("excludes_zero").get<bool>();
-        hd = std::string("<span class=\"") + (excl ? (est > 0 ? "up" : "down") : "") + "\">" + detail::xml_escape(d) + "</span>";
-        entry["cells"].push_back({{"task", std::get<0>(c)}, {"split", std::get<1>(c)}, {"backbone", std::get<2>(c)},
-                                  {"success_once", cell != row.cells.end() ? cell->second.at("success_once") : json(nullptr)},
-                                  {"difference", diff}, {"promotion", k.at("promotion")}});
-      } else if (cell != row.cells.end()) {
-        entry["cells"].push_back({{"task", std::get<0>(c)}, {"split", std::get<1>(c)}, {"backbone", std::get<2>(c)},
-                                  {"success_once", cell->second.at("success_once")}, {"difference", nullptr}, {"promotion", nullptr}});
-      }
-      md << " " << s << " | " << md_cell(d) << " |";
-      html << "<td>" << detail::xml_escape(s) << "</td><td>" << (cmpi != row.comparisons.end() ? hd : detail::xml_escape(d)) << "</td>";
+    for (const auto& b : backbones) {
+      double sum = 0.0;
+      int n = 0;
+      for (const auto& [id, c] : row.cells)
+        if (std::get<2>(id) == b) {
+          sum += c.at("success_once").at("rate").get<double>();
+          ++n;
+        }
+      const std::string t = n ? r3(sum / n) + " (" + std::to_string(n) + ")" : "–";
+      md << " " << t << " |";
+      html << "<td>" << t << "</td>";
     }
-    md << "\n";
-    html << "</tr>";
+    int better = 0, worse = 0, same = 0;
+    for (const auto& [id, k] : row.comparisons) {
+      const std::string cls = delta_class(k);
+      (cls == "up" ? better : cls == "down" ? worse : same) += 1;
+    }
+    const std::string counts = is_ref ? "reference" : std::to_string(better) + " / " + std::to_string(worse) + " / " + std::to_string(same);
+    md << " " << counts << " |\n";
+    html << "<td>" << counts << "</td></tr>";
+    for (const auto& [id, c] : row.cells) {
+      const auto k = row.comparisons.find(id);
+      entry["cells"].push_back({{"task", std::get<0>(id)}, {"split", std::get<1>(id)}, {"backbone", std::get<2>(id)},
+                                {"success_once", c.at("success_once")},
+                                {"difference", k != row.comparisons.end() ? k->second.at("difference") : json(nullptr)},
+                                {"promotion", k != row.comparisons.end() ? k->second.at("promotion") : json(nullptr)}});
+    }
     board.push_back(entry);
   }
-  md << "\nRungs: what the runner handed the method (`pool`: the declared pool, the calibration and the grammar's "
-        "grids; `grammar`: the calibration and the grids; `none`: nothing more; `oracle`: the true contract). Kind: "
-        "`built-in`, or how a user method entered (`cpp`, `python`, `external`; docs/methods.md).\n";
-  html << "</table><p><small>Rungs: what the runner handed the method (pool: the declared pool, the calibration and the "
-          "grammar's grids; grammar: the calibration and the grids; none: nothing more; oracle: the true contract).</small></p>"
-          "</body></html>\n";
+  md << "\n";
+  html << "</table>";
+
+  // one table per (task, split)
+  for (const auto& [ts, bbs] : groups) {
+    const std::string title = ts.first + " / " + ts.second;
+    md << "## " << title << "\n\n| method |";
+    html << "<h2>" << detail::xml_escape(title) << "</h2><table><tr><th>method</th>";
+    for (const auto& b : bbs) {
+      md << " " << md_cell(b) << " | Δ vs " << md_cell(o.reference) << ", " << md_cell(b) << " |";
+      html << "<th>" << detail::xml_escape(b) << "</th><th>&Delta; vs " << detail::xml_escape(o.reference) << ", "
+           << detail::xml_escape(b) << "</th>";
+    }
+    md << "\n|---|";
+    for (std::size_t i = 0; i < bbs.size(); ++i) md << "---|---|";
+    md << "\n";
+    html << "</tr>";
+    for (const auto& row : order) {
+      bool any = false;
+      for (const auto& b : bbs) any = any || row.cells.count({ts.first, ts.second, b});
+      if (!any) continue;
+      const bool is_ref = row.label == o.reference;
+      md << "| " << md_cell(is_ref ? "**" + row.label + "**" : row.label) << " |";
+      html << "<tr" << (is_ref ? " class=\"ref\"" : "") << "><td><code>" << detail::xml_escape(row.label) << "</code></td>";
+      for (const auto& b : bbs) {
+        const CellId id{ts.first, ts.second, b};
+        const auto cell = row.cells.find(id);
+        const auto k = row.comparisons.find(id);
+        const std::string s = cell != row.cells.end() ? success_text(cell->second.at("success_once")) : "–";
+        const std::string d = k != row.comparisons.end() ? delta_text(k->second) : (is_ref ? "reference" : "–");
+        md << " " << s << " | " << md_cell(d) << " |";
+        html << "<td>" << detail::xml_escape(s) << "</td><td><span class=\""
+             << (k != row.comparisons.end() ? delta_class(k->second) : "") << "\">" << detail::xml_escape(d) << "</span></td>";
+      }
+      md << "\n";
+      html << "</tr>";
+    }
+    md << "\n";
+    html << "</table>";
+  }
+  md << "Rungs: what the runner handed the method (`pool`: the declared pool, the calibration and the grammar's grids; "
+        "`grammar`: the calibration and the grids; `none`: nothing more; `oracle`: the true contract). Kind: `built-in`, or "
+        "how a user method entered (`cpp`, `python`, `external`; docs/methods.md).\n";
+  html << "<p><small>Rungs: what the runner handed the method (pool: the declared pool, the calibration and the grammar's "
+          "grids; grammar: the calibration and the grids; none: nothing more; oracle: the true contract). Kind: built-in, or "
+          "how a user method entered (cpp, python, external).</small></p></body></html>\n";
 
   std::error_code ec;
   fs::create_directories(o.out_dir, ec);

@@ -32,12 +32,7 @@ std::string md(const std::string& s) {  // a Markdown table cell
 }
 
 json read_json(const fs::path& p) {
-  require_regular_file(p.string(), "a JSON file");
-  std::ifstream f(p, std::ios::binary);
-  if (!f) throw InputError(p.string(), "", "cannot read file");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  json j = json::parse(ss.str(), nullptr, false);
+  json j = json::parse(read_input_file(p.string(), "a JSON file", kMaxJsonDocumentBytes), nullptr, false);
   if (j.is_discarded() || !j.is_object()) throw InputError(p.string(), "", "not a JSON object");
   return j;
 }

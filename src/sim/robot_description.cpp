@@ -15,6 +15,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -45,6 +46,7 @@ Eigen::Isometry3d to_iso(const urdf::Pose& p) {
 
 constexpr std::size_t kMaxMeshNodes = 100000;  // scene-graph nodes per mesh file
 constexpr int kMaxXmlDepth = 64;                // element nesting; a URDF needs about 5
+constexpr double kMaxLinkMassKg = 1e6;          // a link's mass; the Panda's weigh 0.015-4.97 kg
 
 // process-wide cache of unscaled meshes keyed by resolved path
 std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& file, std::string_view origin) {
@@ -57,8 +59,14 @@ std::shared_ptr<const MeshData> load_mesh_cached(const std::filesystem::path& fi
   }
   const std::string shown = quote_input(key, '\'', 300);  // a path from the URDF, quoted and cut
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
+  if (!std::filesystem::exists(std::filesystem::status(file, ec)))
     fail(origin, "mesh file not found: " + shown);
+  // a special or oversized file is refused before assimp opens it (it reads the whole file)
+  try {
+    (void)check_input_file(key, "a mesh file", kMaxMeshFileBytes);
+  } catch (const InputError& e) {
+    fail(origin, "mesh " + shown + ": " + e.reason());
+  }
   Assimp::Importer importer;
   // Collada files carry an <up_axis>; assimp rotates Z_UP files into its Y-up convention by default,
   // which would turn a .dae collision mesh 90 degrees about x relative to its STL/OBJ twin. A URDF
@@ -339,6 +347,13 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
   for (const auto& l : order) index[l->name] = static_cast<int>(index.size());
   out.root = 0;
 
+  // links that move: the child of a revolute or prismatic joint (a fixed child is merged into its parent)
+  std::set<std::string> moving;
+  for (const auto& kv : model->joints_) {
+    const auto& j = kv.second;
+    if (j && (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC))
+      moving.insert(j->child_link_name);
+  }
   for (const auto& l : order) {
     LinkDescription ld;
     ld.name = l->name;
@@ -352,6 +367,15 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
       ld.inertial.inertia = o.linear() * in * o.linear().transpose();
       if (!(ld.inertial.mass >= 0.0) || !std::isfinite(ld.inertial.mass))
         fail(origin, "link " + l->name + ": inertial mass must be finite and >= 0");
+      // a link given an <inertial> that moves with a joint must have mass (Bullet divides by it; a
+      // frame-only link has no <inertial> at all), and no manipulator link weighs a thousand tonnes
+      if (ld.inertial.mass == 0.0 && moving.count(l->name))
+        fail(origin, "link " + l->name + ": inertial mass: must be > 0 on a link moved by a joint (got 0; leave out <inertial> for a frame-only link)");
+      if (ld.inertial.mass > kMaxLinkMassKg) {
+        char got[32];
+        std::snprintf(got, sizeof got, "%g", ld.inertial.mass);
+        fail(origin, "link " + l->name + ": inertial mass: " + got + " kg is more than 1e6 kg (the Panda's links weigh 0.015-4.97 kg)");
+      }
       if (!finite(o)) fail(origin, "link " + l->name + ": inertial origin is not finite");
       if (const std::string why = inertia_problem(in); !why.empty()) fail(origin, "link " + l->name + ": " + why);
     }
@@ -472,13 +496,9 @@ RobotDescription parse_urdf(std::string_view xml, const std::filesystem::path& b
 
 RobotDescription load_urdf_file(const std::filesystem::path& urdf, const PackageMap& packages) {
   if (urdf.empty()) fail("--robot", "empty path (name a URDF file)");
-  require_regular_file(urdf.string(), "a URDF file");
-  std::ifstream in(urdf, std::ios::binary);
-  if (!in) fail(urdf.string(), "cannot open URDF file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = read_input_file(urdf.string(), "a URDF file", kMaxSmallFileBytes);
   const auto dir = std::filesystem::absolute(urdf).parent_path();
-  return parse_urdf(ss.str(), dir, packages, urdf.string());
+  return parse_urdf(text, dir, packages, urdf.string());
 }
 
 std::string_view panda_urdf_text() { return embedded::panda_urdf; }

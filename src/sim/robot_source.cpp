@@ -21,14 +21,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_bytes(const std::string& path, const std::string& field) {
-  require_regular_file(path, "a robot file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, field, "cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path, field, "cannot read file");
-  return ss.str();
+std::string read_bytes(const std::string& path, const std::string& field, const std::string& what, std::uintmax_t max_bytes) {
+  try {
+    return read_input_file(path, what, max_bytes);
+  } catch (const InputError& e) {
+    throw InputError(e.source(), field, e.reason());
+  }
 }
 
 }  // namespace
@@ -56,7 +54,7 @@ std::string robot_content_sha256(std::string_view urdf_bytes, const RobotDescrip
     for (const auto& c : link.collisions)
       if (c.type == CollisionGeometry::Type::kMesh && c.mesh) sources.insert(c.mesh->source);
   std::set<std::string> mesh_hashes;
-  for (const auto& s : sources) mesh_hashes.insert(sha256_hex(read_bytes(s, "mesh")));
+  for (const auto& s : sources) mesh_hashes.insert(sha256_hex(read_bytes(s, "mesh", "a mesh file", kMaxMeshFileBytes)));
   nlohmann::json j = nlohmann::json::object();
   j["urdf"] = sha256_hex(urdf_bytes);
   j["meshes"] = nlohmann::json::array();
@@ -96,14 +94,16 @@ void check_drivable(const RobotDescription& desc, const std::string& urdf) {
 
 RobotSource load_robot_source(const std::string& urdf, const std::map<std::string, std::string>& packages) {
   std::error_code ec;
-  if (!fs::is_regular_file(urdf, ec)) throw InputError(urdf, "robot", "no such URDF file");
+  if (urdf.empty()) throw InputError("--robot", "", "empty path (name a URDF file)");
+  if (!fs::exists(fs::status(urdf, ec))) throw InputError(urdf, "robot", "no such URDF file");
   RobotSource r;
   r.urdf = fs::absolute(urdf, ec).lexically_normal().string();
   r.packages = packages;
   PackageMap pm;
   for (const auto& [name, dir] : packages) pm[name] = dir;
-  const std::string bytes = read_bytes(r.urdf, "robot");
-  auto desc = std::make_shared<RobotDescription>(load_urdf_file(r.urdf, pm));
+  // one read: the bytes hashed are the bytes parsed (a directory, FIFO or oversized file is refused here)
+  const std::string bytes = read_bytes(r.urdf, "robot", "a URDF file", kMaxSmallFileBytes);
+  auto desc = std::make_shared<RobotDescription>(parse_urdf(bytes, fs::path(r.urdf).parent_path(), pm, r.urdf));
   check_drivable(*desc, urdf);
   r.sha256 = robot_content_sha256(bytes, *desc);
   r.description = std::move(desc);

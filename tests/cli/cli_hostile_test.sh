@@ -57,8 +57,9 @@ expect_rc 2 "overflowing record"
 expect_one_line_error "overflowing record"
 expect_err ": return: number out of range" "overflowing record names the field"
 expect_err "out of range" "overflowing record says why"
-# a resume repairs a last record that ends in 1e999 (a torn write), with nothing else lost; a torn write
-# happens before the job's summary is written (a summary covering the record would refuse it as an edit)
+# a complete (newline-terminated) last line that does not parse is not a torn write: a resume
+# refuses it, naming file and line, and leaves the file byte for byte as it was
+# (the job's summary is removed first: a summary covering the line would refuse it as an edited record)
 rm "${JL%.jsonl}.summary.json"
 python3 - "$JL" <<'PY'
 import re, sys
@@ -67,8 +68,20 @@ lines = open(p).read().splitlines()
 lines[-1] = re.sub(r'"backbone_sha256":"[0-9a-f]*"', '"backbone_sha256":1e999', lines[-1])
 open(p, 'w').write('\n'.join(lines) + '\n')
 PY
+BEFORE=$(sha256sum "$JL" | cut -d' ' -f1)
 run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/r" --progress off
-expect_rc 0 "resume over a 1e999 record"
+expect_rc 2 "resume over a complete 1e999 last line"
+expect_one_line_error "resume over a complete 1e999 last line"
+expect_err "$JL:3: backbone_sha256" "complete unparsable last line names file, line and field"
+[ "$(sha256sum "$JL" | cut -d' ' -f1)" = "$BEFORE" ] && ok || bad "a complete unparsable last line was changed"
+# an unterminated last line (no newline: a torn write) is repaired, with nothing else lost
+python3 - "$JL" "$TMP/clean.jsonl" <<'PY'
+import sys
+lines = open(sys.argv[2]).read().splitlines()
+open(sys.argv[1], 'w').write('\n'.join(lines[:-1]) + '\n' + lines[-1][:len(lines[-1]) // 2])
+PY
+run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 3 --threads 1 --out "$TMP/r" --progress off
+expect_rc 0 "resume over an unterminated last line"
 expect_err "repaired a torn last line" "resume logs the repair"
 cmp -s "$JL" "$TMP/clean.jsonl" && ok || bad "the repaired JSONL differs from the clean run"
 
@@ -108,6 +121,20 @@ run "$AS" plan --experiment "$TMP/big.yaml" --out "$TMP/bigplan"
 expect_rc 2 "oversized YAML"
 expect_one_line_error "oversized YAML"
 expect_err "too large" "oversized YAML"
+# a small experiment whose grid is too large: refused from its list sizes before any job is made
+# (an 80 KB experiment expanded to 180,000 jobs and a 220 MB plan)
+python3 - "$TMP/grid.yaml" <<'PY'
+import sys
+seeds = ', '.join(str(s) for s in range(10001))
+open(sys.argv[1], 'w').write('name: grid\ntasks: [pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side]\n'
+                             'splits: [seen, unseen_value]\nmethods: [oracle]\nseeds: [' + seeds + ']\nepisodes: 1\nbackbone: expert\n')
+PY
+run timeout 20 "$AS" plan --experiment "$TMP/grid.yaml" --out "$TMP/gridplan"
+expect_rc 2 "experiment of 100,010 jobs"
+expect_one_line_error "experiment of 100,010 jobs"
+expect_err "$TMP/grid.yaml: the experiment expands to 100010 jobs (5 tasks x 2 splits x 1 methods x 10001 seeds), at most 100000" \
+  "experiment of 100,010 jobs names the file and the count"
+[ ! -e "$TMP/gridplan" ] && ok || bad "a refused experiment left a plan directory"
 printf 'name: x\nmethods: %s\n' "$(deep 100000)" > "$TMP/deep.yaml"
 run "$AS" plan --experiment "$TMP/deep.yaml" --out "$TMP/deepplan"
 expect_rc 2 "deep YAML"
@@ -203,7 +230,7 @@ for seed in -1 18446744073709551616; do
 done
 run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 99999999999999999999 --out "$TMP/sd" --progress off
 expect_rc 2 "episodes beyond int64"
-expect_err "episodes: must be at most 1000000000" "episodes beyond int64"
+expect_err "--episodes: out of range: '99999999999999999999' does not fit a 64-bit integer" "episodes beyond int64"
 run "$AS" run --task pick_cube --split reference_seen --method oracle --episodes 1 --step-timeout nan --out "$TMP/sd" --progress off
 expect_rc 2 "step-timeout nan"
 [ ! -e "$TMP/sd" ] || [ -z "$(ls -A "$TMP/sd")" ] && ok || bad "a refused run wrote results"

@@ -109,7 +109,7 @@ TEST_F(CmdEvalTest, Gate1WritesVerdictAndGateCheckCatchesRegression) {
 TEST_F(CmdEvalTest, GateCheckBadInput) {
   std::ostringstream out, err;
   EXPECT_EQ(run_gate_check({(root_ / "none.json").string(), results(), ""}, out, err), 2);
-  EXPECT_THAT(err.str(), HasSubstr("none.json: cannot open file"));
+  EXPECT_THAT(err.str(), HasSubstr("none.json: no such file (expected a JSON file)"));
   {
     std::ofstream f(root_ / "g0.json");
     f << R"({"gate":"gate0","cells":{"expert/pick_cube":{"verdict":"pass"}}})";

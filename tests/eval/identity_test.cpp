@@ -116,7 +116,7 @@ TEST_F(IdentityTest, PolicyFilesContentEntersTheIdAndEditsMakeANewJob) {
   EXPECT_NE(job_id(edited), v1);
   EXPECT_EQ(job_from_json(job_to_json(a), "spec"), a);
   EXPECT_THAT([&] { files_content_sha256({(root_ / "missing.py").string()}); },
-              ThrowsMessage<InputError>(HasSubstr("missing.py: --policy-files: cannot read file")));
+              ThrowsMessage<InputError>(HasSubstr("missing.py: --policy-files: no such file (expected a policy file)")));
   EXPECT_THROW(files_content_sha256({}), InputError);
 }
 

@@ -94,7 +94,7 @@ TEST(Experiment, ErrorsNameFileAndField) {
   fails("name: [unclosed\n", "e.yaml:");
   fails("name: [unclosed\n", "malformed YAML");
   fails("- just\n- a list\n", "expected a mapping");
-  EXPECT_THAT([] { load_experiment("/nonexistent/e.yaml"); }, ThrowsMessage<InputError>(HasSubstr("/nonexistent/e.yaml: cannot open file")));
+  EXPECT_THAT([] { load_experiment("/nonexistent/e.yaml"); }, ThrowsMessage<InputError>(HasSubstr("/nonexistent/e.yaml: no such file (expected an experiment file)")));
   // found by the fuzz replay: text that is not UTF-8 (its strings become JSON, whose dump threw
   // nlohmann's type_error 316), a "\ud800" escape (a surrogate), and values echoed with their newlines
   fails(base + "description: caf\xe9\n", "e.yaml:8: not valid UTF-8 (byte offset");

@@ -155,7 +155,7 @@ TEST(RecordFile, ReadsAllLinesAndReportsATornTail) {
   ASSERT_EQ(rf.records.size(), 2u);
   EXPECT_EQ(rf.records[1], r1);
   EXPECT_THAT([&] { read_record_file((dir / "missing.jsonl").string()); },
-              ThrowsMessage<InputError>(HasSubstr("cannot open file")));
+              ThrowsMessage<InputError>(HasSubstr("missing.jsonl: no such file (expected a results file)")));
   std::filesystem::remove_all(dir);
 }
 

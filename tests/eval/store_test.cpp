@@ -108,21 +108,28 @@ TEST_F(StoreTest, RepairsAnUnterminatedTail) {
   EXPECT_EQ(after, good.substr(0, good.rfind('\n', good.size() - 2) + 1));
 }
 
-TEST_F(StoreTest, RepairsAGarbageLastLine) {
+// only an unterminated last line is a torn write: a complete line that does not parse was written
+// whole (or edited), so it is an error naming file and line and the file is never changed
+TEST_F(StoreTest, ACompleteUnparsableLastLineIsAnErrorAndTheFileIsUntouched) {
   const JobSpec job = testing::fake_job(5);
   {
     auto s = ResultStore::open(dir_.string(), job);
     s.append(record(job, 0));
   }
   const std::string path = (dir_ / (job_id(job) + ".jsonl")).string();
-  const std::string good = slurp(path);
   {
     std::ofstream f(path, std::ios::app | std::ios::binary);
-    f << std::string(40, '\0') << "\n";  // zero-filled block after a crash
+    f << std::string(40, '\0') << "\n";  // a zero-filled block, newline-terminated
   }
+  const std::string before = slurp(path);
+  EXPECT_THAT([&] { ResultStore::open(dir_.string(), job); },
+              ThrowsMessage<InputError>(HasSubstr(path + ":2: ")));
+  EXPECT_EQ(slurp(path), before);
+  // the same bytes without their newline are a torn tail, cut away
+  fs::resize_file(path, before.size() - 1);
   auto s = ResultStore::open(dir_.string(), job);
   EXPECT_EQ(s.episodes_done(), 1);
-  EXPECT_EQ(slurp(path), good);
+  EXPECT_EQ(slurp(path), before.substr(0, before.size() - 41));
 }
 
 TEST_F(StoreTest, CorruptMiddleLineIsAnErrorAndTheFileIsUntouched) {

@@ -58,7 +58,7 @@ TEST(MlpFormat, TruncatedCorruptAndWrongShapeAreOneLineErrors) {
   ASSERT_NE(at, std::string::npos);
   relabel.replace(at, 18, "\"task\":\"push_cube\"");
   expect_input_error([&] { policy::parse_mlp(relabel, "w.asmlp"); }, "input size 42 does not match task push_cube (expected 35)");
-  expect_input_error([] { policy::load_mlp("/nonexistent/w.asmlp"); }, "/nonexistent/w.asmlp: cannot open weight file");
+  expect_input_error([] { policy::load_mlp("/nonexistent/w.asmlp"); }, "/nonexistent/w.asmlp: no such file");
 }
 
 // the header's text replaced (its length field rewritten), as a hostile writer would

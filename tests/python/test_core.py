@@ -151,6 +151,18 @@ def test_decoder_sizes_and_contract_dict_errors_are_one_line():
     assert not str(e.value).startswith("contract: contract:")
 
 
+def test_an_int_too_large_for_its_parameter_is_out_of_range_not_a_type_error():
+    # was "Contract(): lag: expected an int (got int)"
+    for call, field in [(lambda: actionshift.Contract(lag=2 ** 63), "lag"),
+                        (lambda: actionshift.Contract(permutation=[2 ** 64, 1, 2, 3, 4, 5]), "permutation"),
+                        (lambda: actionshift.SelfTest(budget=2 ** 40), "budget")]:
+        with pytest.raises(ValueError) as e:
+            call()
+        assert f"(): {field}: out of range: " in str(e.value), str(e.value)
+        assert "is too large in magnitude" in str(e.value)
+        assert "\n" not in str(e.value)
+
+
 @pytest.mark.parametrize("call, message", [
     (lambda: actionshift.Contract(1, 2, 3), "Contract(): permutation: expected a sequence of 6 integers (got int)"),
     (lambda: actionshift.Contract(lag="2"), "Contract(): lag: expected an int (got str)"),

@@ -211,6 +211,16 @@ TEST(HostileUrdf, PhysicallyInvalidLimitsAndInertiasAreRejected) {
   EXPECT_THAT(rejection(mass), HasSubstr("mass"));
 }
 
+TEST(HostileUrdf, MasslessOrAbsurdlyHeavyMovingLinksAreRejected) {
+  // a moving link with an explicit zero mass, and a 1e30 kg link, were accepted
+  EXPECT_THAT(rejection(panda_with(R"(<mass value="4.970684"/>)", R"(<mass value="0"/>)")),
+              HasSubstr("link panda_link1: inertial mass: must be > 0 on a link moved by a joint"));
+  EXPECT_THAT(rejection(panda_with(R"(<mass value="4.970684"/>)", R"(<mass value="1e30"/>)")),
+              HasSubstr("link panda_link1: inertial mass: 1e+30 kg is more than 1e6 kg"));
+  // the fixed root may be massless (it does not move), and a frame-only moving link has no <inertial>
+  EXPECT_NO_THROW(parse_urdf(panda_with(R"(<mass value="0.629769"/>)", R"(<mass value="0"/>)"), "."));
+}
+
 TEST(HostileUrdf, LongMeshNamesAreCutInMessages) {
   const std::string toy = R"(<robot name="toy"><link name="a"><collision><geometry><mesh filename="NAME"/></geometry></collision></link></robot>)";
   const auto with_name = [&](const std::string& v) { std::string t = toy; t.replace(t.find("NAME"), 4, v); return t; };

@@ -137,12 +137,7 @@ class Manifest {
 
   /// Reads and parses a manifest file. Throws InputError naming the file.
   static Manifest load(const std::string& path) {
-    require_regular_file(path, "a manifest file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot open file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
+    const std::string text = read_input_file(path, "a manifest file", kMaxManifestBytes);
     if (text.empty()) throw InputError(path, "", "file is empty");
     return parse(text, path);
   }

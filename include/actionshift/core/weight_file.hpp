@@ -91,17 +91,7 @@ inline void check_payload(const Unframed& u, std::int64_t floats, const std::str
 /// The whole file at `path` (at most `max_bytes`); InputError(path, "", …) for a directory, an
 /// oversized or unreadable file.
 inline std::string read(const std::string& path, std::uintmax_t max_bytes, const std::string& what) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a file (expected " + what + ")");
-  require_regular_file(path, what);
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > max_bytes)
-    throw InputError(path, "", "weight file too large (" + std::to_string(size) + " bytes, at most " + std::to_string(max_bytes) + ")");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path, "", "cannot open " + what);
-  std::string bytes(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>{});
-  if (f.bad()) throw InputError(path, "", "read error");
-  return bytes;
+  return read_input_file(path, what, max_bytes);
 }
 
 /// Writes `bytes` to `path` through a temporary file renamed over it (readers never see half a

@@ -51,6 +51,12 @@ int finger_start(const sim::ObservationLayout& layout);
 /// Throws std::invalid_argument if the layout has no 7-wide tcp_pose field.
 adapt::TcpSlice tcp_slice(const sim::ObservationLayout& layout);
 
+/// The one check that a calibration fits a task's observation (used by `run`, `selftest --sim` and
+/// Python): its TCP position and quaternion offsets, and its finger channel's offset if it has one,
+/// must be where `layout` has them. Throws InputError(source, field, …) naming the offset.
+void check_calibration_layout(const adapt::ResponseCalibration& cal, const sim::ObservationLayout& layout,
+                              const std::string& task, const std::string& source);
+
 /// Runs the calibration on the model's fidelity profile: walk/episode e resets with
 /// derive_seed({seed, e}) and draws uniform actions in [-1, 1]^7 from Rng(derive_seed({seed, e, 1}));
 /// each response is paired with its action as the protocol says. Deterministic in (model, options).

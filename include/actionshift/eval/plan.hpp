@@ -113,8 +113,18 @@ struct Plan {
   std::vector<PlannedJob> jobs; ///< tasks × splits × methods × seeds, nested in that order (seed innermost)
 };
 
+/// Most jobs one plan may hold. The largest committed experiment (tournament.yaml) has 936; a plan
+/// file costs about 1.2 KB per job, so 100,000 jobs are a 120 MB plan (an 80 KB experiment used to
+/// expand to 180,000 jobs and a 220 MB plan). parse_experiment, make_plan and plan_from_json check it
+/// from the list sizes, before any job is expanded or read.
+inline constexpr std::uint64_t kMaxPlanJobs = 100000;
+
+/// tasks × splits × methods × seeds of `ex`, saturating at UINT64_MAX.
+std::uint64_t experiment_job_count(const Experiment& ex);
+
 /// Expand an experiment into its jobs (stable order: tasks, then splits, methods, seeds, each in
-/// file order). Throws actionshift::InputError from the resolver or for an invalid job.
+/// file order). Throws actionshift::InputError from the resolver or for an invalid job, and (before
+/// expanding) for more than kMaxPlanJobs jobs.
 Plan make_plan(const Experiment& experiment, const PlanResolver& resolver);
 
 /// Plan file object: {"schema_version","experiment","source","source_sha256","job_count","jobs":[{"index","job_id","spec"}]}.

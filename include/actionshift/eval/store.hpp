@@ -2,9 +2,9 @@
 /// \file The append-only result store of one job: `<out>/<id>.jsonl` plus `<out>/<id>.summary.json`.
 ///
 /// Each record is appended as one whole line by a single write(2) and flushed to the kernel at once,
-/// so a killed process leaves at most one torn (unterminated or unparsable) last line. Opening the
-/// store validates every existing line, repairs such a tail by truncation, and refuses (without
-/// touching the file) anything else that is wrong. The store also holds an exclusive flock(2) on the
+/// so a killed process leaves at most one torn (unterminated: no trailing newline) last line. Opening
+/// the store validates every existing line, repairs such a tail by truncation, and refuses (without
+/// touching the file) anything else that is wrong, including a complete last line that does not parse. The store also holds an exclusive flock(2) on the
 /// JSONL file, so two processes cannot run the same job into the same directory at once.
 
 #include "actionshift/eval/job.hpp"

@@ -17,6 +17,7 @@ struct LeaderboardOptions {
   std::string out_dir;                     ///< where leaderboard.{md,html,json} are written
   std::string reference{"entropy_probes"};  ///< every other label is compared with this one, paired, cell by cell
   bool common_episodes{false};             ///< pair only the episodes both cells hold (`compare --common-episodes`)
+  std::vector<std::string> splits;         ///< only these splits' cells (empty: every split)
   std::string command;                     ///< the command line that made the page (printed on it)
 };
 
@@ -27,7 +28,8 @@ struct LeaderboardResult {
   std::size_t cells{0};    ///< (task, split, backbone) columns
 };
 
-/// Writes `<out>/leaderboard.md`, `<out>/leaderboard.html` and `<out>/leaderboard.json` (the
+/// Writes `<out>/leaderboard.md` (an overall table, then one table per (task, split) with a column pair per
+/// backbone), `<out>/leaderboard.html` and `<out>/leaderboard.json` (the
 /// comparison JSON of `actionshift compare` plus each row's rung and kind). Rows are sorted by their
 /// mean success over the cells they have; a method's rung is the built-in's or, for a user method, the
 /// one its job declares. Throws InputError for a directory without records, a reference label found in
