@@ -23,12 +23,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -121,6 +123,17 @@ class PolicyLeftovers {
   ~PolicyLeftovers() {
     if (!subreaper_) return;
     int killed = 0;
+    // members of a policy group killed a moment ago may have been re-parented here before they die:
+    // reap what has died for up to 100 ms before killing (and counting) what is still alive
+    for (int wait = 0; wait < 10; ++wait) {
+      bool alive = false;
+      for (const auto& [pid, zombie] : children_of(getpid())) {
+        if (zombie) waitpid(pid, nullptr, 0);
+        alive = alive || !zombie;
+      }
+      if (!alive) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     // a killed leftover's own children are re-parented here in turn: a few rounds
     for (int round = 0; round < 100; ++round) {
       const std::vector<std::pair<pid_t, bool>> children = children_of(getpid());
