@@ -11,21 +11,28 @@
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/store.hpp"
 #include "actionshift/eval/summary.hpp"
+#include "actionshift/policy/external.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
+#include <utility>
+#include <vector>
 
 namespace actionshift::cli {
 
@@ -59,20 +66,25 @@ void ensure_parent(const std::string& path) {
 // Ctrl-C (SIGINT) and SIGTERM (what Slurm sends at a time limit) during a job: the first stops it
 // after the episodes already finished, with the summary saying where (exit 130, re-run to resume);
 // a second one ends the process at once. Signals ignored when the process started stay ignored.
+// The first also reaches external policies at once (one blocked in a step is not waited for: its
+// group is killed when the job stops); the second kills their process groups before the process ends.
 std::atomic<bool> g_interrupt{false};
 static_assert(std::atomic<bool>::is_always_lock_free);
 
 extern "C" void on_interrupt_signal(int sig) {
   if (g_interrupt.exchange(true)) {
+    policy::kill_external_policies();
     std::signal(sig, SIG_DFL);
     std::raise(sig);
   }
+  policy::interrupt_external_policies();
 }
 
 class InterruptHandlers {
  public:
   InterruptHandlers() {
     g_interrupt = false;
+    policy::clear_external_interrupt();
     install(SIGINT, old_int_, has_int_);
     install(SIGTERM, old_term_, has_term_);
   }
@@ -95,8 +107,76 @@ class InterruptHandlers {
   bool has_int_{false}, has_term_{false};
 };
 
+// While a job runs, the process is the subreaper of its descendants (Linux, PR_SET_CHILD_SUBREAPER):
+// a process an external policy started and moved out of its process group (setsid) is re-parented
+// here, not to init, when its parent exits. Once the job's policies are gone (their groups killed),
+// every remaining child is such a leftover: it is killed (with its group, when it leads one) and
+// reaped, and the count noted on stderr. The runner starts no other child processes.
+class PolicyLeftovers {
+ public:
+  explicit PolicyLeftovers(std::ostream& err) : err_(err) { subreaper_ = prctl(PR_SET_CHILD_SUBREAPER, 1) == 0; }
+  ~PolicyLeftovers() {
+    if (!subreaper_) return;
+    int killed = 0;
+    // members of a policy group killed a moment ago may have been re-parented here before they die:
+    // reap what has died for up to 100 ms before killing (and counting) what is still alive
+    for (int wait = 0; wait < 10; ++wait) {
+      bool alive = false;
+      for (const auto& [pid, zombie] : children_of(getpid())) {
+        if (zombie) waitpid(pid, nullptr, 0);
+        alive = alive || !zombie;
+      }
+      if (!alive) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    // a killed leftover's own children are re-parented here in turn: a few rounds
+    for (int round = 0; round < 100; ++round) {
+      const std::vector<std::pair<pid_t, bool>> children = children_of(getpid());
+      if (children.empty()) break;
+      for (const auto& [pid, zombie] : children) {
+        if (!zombie) {
+          if (getpgid(pid) == pid) kill(-pid, SIGKILL);
+          if (kill(pid, SIGKILL) == 0) ++killed;
+        }
+        waitpid(pid, nullptr, 0);
+      }
+    }
+    prctl(PR_SET_CHILD_SUBREAPER, 0);
+    if (killed > 0)
+      err_ << "actionshift: note: killed " << killed << (killed == 1 ? " process" : " processes")
+           << " an external policy left behind outside its process group (setsid?)\n";
+  }
+  PolicyLeftovers(const PolicyLeftovers&) = delete;
+  PolicyLeftovers& operator=(const PolicyLeftovers&) = delete;
+
+ private:
+  // the children of `parent` from /proc/<pid>/stat (pid, is a zombie)
+  static std::vector<std::pair<pid_t, bool>> children_of(pid_t parent) {
+    std::vector<std::pair<pid_t, bool>> out;
+    std::error_code ec;
+    fs::directory_iterator it("/proc", ec), end;
+    for (; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+      std::ifstream in(it->path() / "stat");
+      std::string stat;
+      if (!std::getline(in, stat)) continue;
+      const auto paren = stat.rfind(')');  // the command name may hold spaces and parentheses
+      if (paren == std::string::npos) continue;
+      std::istringstream rest(stat.substr(paren + 1));
+      char state = 0;
+      long ppid = 0;
+      if (rest >> state >> ppid && ppid == parent) out.emplace_back(static_cast<pid_t>(std::stol(name)), state == 'Z');
+    }
+    return out;
+  }
+  std::ostream& err_;
+  bool subreaper_{false};
+};
+
 eval::RunResult run_with(const eval::JobSpec& job, const RunPlanOptions& o, const EpisodeFnFactory& make,
                          std::ostream& out, std::ostream& err) {
+  const PolicyLeftovers leftovers(err);  // destroyed last: after the job's policies
   const InterruptHandlers handlers;
   eval::RunOptions ro;
   ro.interrupted = [] { return g_interrupt.load(); };
@@ -105,7 +185,13 @@ eval::RunResult run_with(const eval::JobSpec& job, const RunPlanOptions& o, cons
   ro.progress = parse_progress_mode(o.progress);
   ro.fsync = o.fsync;
   ro.log = &err;
-  const eval::EpisodeFn fn = make(job);
+  eval::EpisodeFn fn;
+  try {
+    fn = make(job);  // starts an external policy (its hello may wait for the hello timeout)
+  } catch (const std::runtime_error&) {
+    if (g_interrupt.load()) throw eval::Interrupted("interrupted before the first episode");
+    throw;
+  }
   const eval::RunResult r = eval::run_job(job, fn, ro);
   out << r.job_id << " " << job.task << "/" << job.split.name << "/" << job.method << " seed " << job.seed << ": "
       << (r.already_complete ? "already complete" : std::to_string(r.episodes_run) + " episodes run") << ", "

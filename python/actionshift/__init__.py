@@ -195,7 +195,10 @@ class Env(_EnvBase):
         raise KeyError(f"observation has no field {name!r} (fields: {[f['name'] for f in self.layout]})")
 
     def close(self):
-        pass
+        """Free the simulation (its Bullet world). Later reset/step raise RuntimeError("environment
+        is closed ..."); closing again does nothing. Safe while another thread steps: calls that
+        touch the world take turns (one lock per environment)."""
+        self._env.close()
 
     def __repr__(self):
         return f"<actionshift.Env {self.task} rotation={self.rotation} profile={self.profile}>"
@@ -233,7 +236,9 @@ class VecEnv:
         return self._env.step(actions)
 
     def close(self):
-        pass
+        """Free every environment's simulation and the worker threads; later reset/step raise
+        RuntimeError("environment is closed ..."); closing again does nothing."""
+        self._env.close()
 
 
 def make(task="pick_cube", contract=None, split=None, index=0, profile="maniskill", rotation="live"):

@@ -387,32 +387,47 @@ std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
   return *last;
 }
 
+// Closed environments: every later call raises this (close() itself may be called again).
+[[noreturn]] void closed_error() { throw std::runtime_error("environment is closed (close() released its simulation)"); }
+
 // One environment under a hidden contract (identity if none was given). Observations come back as
 // fresh numpy arrays (one copy of ~40 doubles, so a stored observation is never overwritten);
 // actions are read in place when they are float64 and contiguous.
+//
+// Threads: the GIL is released while Bullet steps, so two Python threads could otherwise be inside
+// one world at once (SIGSEGV in Bullet's island manager). Every call that touches the world holds
+// mutex_, taken after the GIL is released (never the other way round, which would deadlock against a
+// thread that holds the mutex and waits for the GIL) and released before the GIL is taken back: the
+// results are copied out under the mutex, Python objects are built after. Concurrent calls take turns.
 class PyEnv {
  public:
   PyEnv(const std::string& task, py::handle contract, std::optional<std::string> split, std::int64_t index,
         const std::string& rotation, const std::string& profile)
       : model_(env_model(sim::parse_task(task), profile)),
-        env_(model_, pick_contract(contract, split, index), parse_rotation(rotation)),
+        env_(std::make_unique<sim::HiddenContractEnv>(model_, pick_contract(contract, split, index), parse_rotation(rotation))),
         profile_(profile),
         rotation_(rotation) {}
 
   py::tuple reset(std::optional<std::uint64_t> seed) {
-    const std::uint64_t s = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
-    const Eigen::VectorXd* obs = nullptr;
+    Eigen::VectorXd obs;
+    sim::StepResult last;
+    sim::EpisodeStats episode;
+    std::uint64_t s = 0;
     {
       py::gil_scoped_release release;
-      obs = &env_.reset(s);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!env_) closed_error();
+      s = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
+      obs = env_->reset(s);
+      last = env_->last();
+      episode = env_->episode();
     }
-    py::dict info = step_info(env_.last(), env_.episode());
+    py::dict info = step_info(last, episode);
     info["seed"] = s;
-    return py::make_tuple(vec_out(*obs), info);
+    return py::make_tuple(vec_out(obs), info);
   }
 
   py::tuple step(py::handle action) {
-    if (!last_seed_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
     DArray a = ensure_numbers(action, "action");
     if (!a) {
       PyErr_Clear();
@@ -420,22 +435,38 @@ class PyEnv {
     }
     if (a.ndim() != 1) value_error("action: must be a 1-D array of 7 numbers (got shape " + shape_of(a) + ")");
     const std::span<const double> raw(a.data(), static_cast<std::size_t>(a.shape(0)));
-    const sim::StepResult* r = nullptr;
+    sim::StepResult r;
+    sim::EpisodeStats episode;
     {
       py::gil_scoped_release release;
-      r = &env_.step(raw);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!env_) closed_error();
+      if (!last_seed_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
+      r = env_->step(raw);
+      episode = env_->episode();
     }
-    const bool safety = r->safety != sim::SafetyFlag::kNone;
-    return py::make_tuple(vec_out(r->obs), r->reward, r->terminated || safety, r->truncated && !safety,
-                          step_info(*r, env_.episode()));
+    const bool safety = r.safety != sim::SafetyFlag::kNone;
+    return py::make_tuple(vec_out(r.obs), r.reward, r.terminated || safety, r.truncated && !safety, step_info(r, episode));
   }
 
-  std::string task() const { return std::string(sim::task_name(env_.task())); }
-  int horizon() const { return env_.horizon(); }
-  int obs_dim() const { return env_.layout().size(); }
+  // frees the Bullet world; waits for a call of another thread to finish first
+  void close() {
+    std::unique_ptr<sim::HiddenContractEnv> gone;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      gone = std::move(env_);
+      gone.reset();
+    }
+  }
+
+  // fixed at construction: read from the shared model, never from the world
+  std::string task() const { return std::string(sim::task_name(model_->task())); }
+  int horizon() const { return model_->horizon(); }
+  int obs_dim() const { return model_->layout().size(); }
   py::list layout() const {
     py::list out;
-    for (const auto& f : env_.layout().fields()) {
+    for (const auto& f : model_->layout().fields()) {
       py::dict d;
       d["name"] = f.name;
       d["offset"] = f.offset;
@@ -449,7 +480,8 @@ class PyEnv {
 
  private:
   std::shared_ptr<const sim::EnvModel> model_;
-  sim::HiddenContractEnv env_;
+  std::mutex mutex_;                               // guards env_ and last_seed_
+  std::unique_ptr<sim::HiddenContractEnv> env_;    // null once closed
   std::string profile_, rotation_;
   std::optional<std::uint64_t> last_seed_;
 };
@@ -530,7 +562,8 @@ class WorkerPool {
 // Environment i runs the given contract, or test[(index + i) mod n] of a split; reset(seed) seeds
 // environment i with seed + i. An environment whose episode ends (terminated or truncated) is
 // reset in the same call: the returned row is the new episode's first observation and
-// info["final_obs"][i] the last one of the ended episode.
+// info["final_obs"][i] the last one of the ended episode. Calls from several Python threads take turns
+// on mutex_ (taken with the GIL released, as in PyEnv); close() frees the worlds and the worker threads.
 // each environment holds its own Bullet world, about 0.2 MB once reset: 4096 of them take about 1 GB
 constexpr int kMaxNumEnvs = 4096;
 
@@ -557,39 +590,54 @@ class PyVecEnv {
     seeds_.assign(static_cast<std::size_t>(num_envs), 0);
     if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
     pool_ = std::make_unique<WorkerPool>(std::min<unsigned>(threads, static_cast<unsigned>(num_envs)));
+    num_envs_ = num_envs;
+    threads_ = pool_->size();
   }
 
-  int num_envs() const { return static_cast<int>(envs_.size()); }
+  // fixed at construction (readable after close)
+  int num_envs() const { return num_envs_; }
   int obs_dim() const { return model_->layout().size(); }
   int horizon() const { return model_->horizon(); }
-  unsigned threads() const { return pool_->size(); }
+  unsigned threads() const { return threads_; }
 
   py::tuple reset(std::optional<std::uint64_t> seed) {
-    const std::uint64_t base = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
-    const auto n = envs_.size();
+    const auto n = static_cast<std::size_t>(num_envs_);
     DArray obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(obs_dim())});
     double* out = obs.mutable_data();
+    std::vector<std::uint64_t> seeds;
     {
       py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (envs_.empty()) closed_error();
+      const std::uint64_t base = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
       for_each_env([&](std::size_t i) {
         seeds_[i] = base + i;
         const Eigen::VectorXd& o = envs_[i].reset(seeds_[i]);
         std::copy(o.data(), o.data() + o.size(), out + i * static_cast<std::size_t>(o.size()));
       });
+      seeds = seeds_;
     }
     py::dict info;
-    info["seed"] = vec_u64(seeds_);
+    info["seed"] = vec_u64(seeds);
     return py::make_tuple(obs, info);
   }
 
+  // frees every world and the worker threads; waits for a call of another thread to finish first
+  void close() {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    pool_.reset();
+    envs_.clear();
+    envs_.shrink_to_fit();
+  }
+
   py::tuple step(py::handle actions) {
-    if (!last_seed_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
     DArray a = ensure_numbers(actions, "actions");
     if (!a) {
       PyErr_Clear();
       value_error("actions: not convertible to an array of numbers");
     }
-    const auto n = envs_.size();
+    const auto n = static_cast<std::size_t>(num_envs_);
     if (a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(n) || a.shape(1) != kActionDim)
       value_error("actions: must have shape (" + std::to_string(n) + ", 7) (got " + shape_of(a) + ")");
     const auto d = static_cast<std::size_t>(obs_dim());
@@ -610,6 +658,9 @@ class PyVecEnv {
     bool* en = ended.mutable_data();
     {
       py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (envs_.empty()) closed_error();
+      if (!last_seed_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
       for_each_env([&](std::size_t i) {
         const sim::StepResult& r = envs_[i].step(std::span<const double>(in + i * kActionDim, kActionDim));
         flags[i] = r.safety;
@@ -657,7 +708,10 @@ class PyVecEnv {
     return out;
   }
   std::shared_ptr<const sim::EnvModel> model_;
-  std::vector<sim::HiddenContractEnv> envs_;
+  int num_envs_{0};
+  unsigned threads_{1};
+  std::mutex mutex_;                          // guards everything below
+  std::vector<sim::HiddenContractEnv> envs_;  // empty once closed
   std::vector<std::uint64_t> seeds_;
   std::optional<std::uint64_t> last_seed_;
   std::unique_ptr<WorkerPool> pool_;
@@ -1403,6 +1457,7 @@ PYBIND11_MODULE(_native, m) {
            py::arg("task"), py::arg("contract"), py::arg("split"), py::arg("index"), py::arg("rotation"), py::arg("profile"))
       .def("reset", &PyEnv::reset, py::arg("seed") = py::none())
       .def("step", &PyEnv::step, py::arg("action"))
+      .def("close", &PyEnv::close)
       .def_property_readonly("task", &PyEnv::task)
       .def_property_readonly("horizon", &PyEnv::horizon)
       .def_property_readonly("obs_dim", &PyEnv::obs_dim)
@@ -1416,6 +1471,7 @@ PYBIND11_MODULE(_native, m) {
            py::arg("rotation"), py::arg("profile"), py::arg("threads"))
       .def("reset", &PyVecEnv::reset, py::arg("seed") = py::none())
       .def("step", &PyVecEnv::step, py::arg("actions"))
+      .def("close", &PyVecEnv::close)
       .def_property_readonly("num_envs", &PyVecEnv::num_envs)
       .def_property_readonly("obs_dim", &PyVecEnv::obs_dim)
       .def_property_readonly("horizon", &PyVecEnv::horizon)

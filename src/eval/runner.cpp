@@ -234,7 +234,20 @@ RunResult run_job(const JobSpec& job, const EpisodeFn& fn, const RunOptions& opt
         while (!cv.wait_for(lock, std::chrono::milliseconds(100), next_or_failed)) poll_interrupted();
         poll_interrupted();
       }
-      if (!ready.count(written)) break;  // the next episode failed: stop at the last contiguous record
+      if (!ready.count(written)) {  // the next episode failed: stop at the last contiguous record
+        // an episode that failed because of the interrupt (an external policy stops waiting for its
+        // reply at SIGINT/SIGTERM) stops the job as the interrupt, not as an error
+        if (failure && !was_interrupted && options.interrupted) {
+          lock.unlock();
+          const bool stop = options.interrupted();
+          lock.lock();
+          if (stop) {
+            failure = std::make_exception_ptr(Interrupted("interrupted"));
+            was_interrupted = true;
+          }
+        }
+        break;
+      }
       EpisodeRecord r = std::move(ready.at(written));
       ready.erase(written);
       lock.unlock();

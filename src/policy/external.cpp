@@ -6,15 +6,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstring>
+#include <exception>
 #include <fcntl.h>
+#include <functional>
 #include <mutex>
 #include <poll.h>
-#include <spawn.h>
 #include <stdexcept>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -22,6 +26,85 @@
 extern char** environ;
 
 namespace actionshift::policy {
+
+namespace {
+// The process groups of the live policy processes, for kill_external_policies() in a signal handler
+// (lock-free slots: a handler may not take a lock). A process beyond the slots is still killed by
+// its ExternalPolicy, just not from a signal handler.
+constexpr std::size_t kTrackedGroups = 1024;
+std::atomic<pid_t> g_groups[kTrackedGroups];
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<pid_t>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
+
+void track_group(pid_t pgid) {
+  for (auto& slot : g_groups) {
+    pid_t expected = 0;
+    if (slot.compare_exchange_strong(expected, pgid)) return;
+  }
+}
+void untrack_group(pid_t pgid) {
+  for (auto& slot : g_groups) {
+    pid_t expected = pgid;
+    if (slot.compare_exchange_strong(expected, 0)) return;
+  }
+}
+
+// Linux sends PR_SET_PDEATHSIG when the *thread* that forked the child ends, not the process: policy
+// processes are forked by this one thread, which lives as long as the process (it is never joined;
+// the object is never destroyed), so a policy started by a short-lived worker thread is not killed
+// when that thread ends. All signals are blocked on it: the process's handlers run elsewhere.
+class Spawner {
+ public:
+  static Spawner& instance() {
+    static Spawner* const spawner = new Spawner();
+    return *spawner;
+  }
+  // runs fn on the spawner thread and waits for it
+  void run(const std::function<void()>& fn) {
+    std::lock_guard<std::mutex> one_at_a_time(call_mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    job_ = &fn;
+    error_ = nullptr;
+    cv_.notify_all();
+    cv_.wait(lock, [this] { return job_ == nullptr; });
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  Spawner() {
+    std::thread([this] {
+      sigset_t all;
+      sigfillset(&all);
+      pthread_sigmask(SIG_BLOCK, &all, nullptr);
+      std::unique_lock<std::mutex> lock(mutex_);
+      for (;;) {
+        cv_.wait(lock, [this] { return job_ != nullptr; });
+        try {
+          (*job_)();
+        } catch (...) {
+          error_ = std::current_exception();
+        }
+        job_ = nullptr;
+        cv_.notify_all();
+      }
+    }).detach();
+  }
+  std::mutex call_mutex_, mutex_;
+  std::condition_variable cv_;
+  const std::function<void()>* job_{nullptr};
+  std::exception_ptr error_;
+};
+}  // namespace
+
+void interrupt_external_policies() noexcept { g_interrupted.store(true); }
+void clear_external_interrupt() noexcept { g_interrupted.store(false); }
+bool external_policies_interrupted() noexcept { return g_interrupted.load(); }
+void kill_external_policies() noexcept {
+  for (auto& slot : g_groups) {
+    const pid_t pgid = slot.load();
+    if (pgid > 0) kill(-pgid, SIGKILL);
+  }
+}
 
 struct ExternalPolicy::Process {
   pid_t pid{-1};
@@ -46,9 +129,12 @@ struct ExternalPolicy::Process {
     if (to_child >= 0) close(to_child);
     if (from_child >= 0) close(from_child);
     if (pid <= 0) return;
-    // give it up to 2 s to exit after stdin is closed, then kill its process group
-    for (int i = 0; i < 200 && !poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    // give it up to 2 s to exit after stdin is closed (none after SIGINT/SIGTERM: a policy blocked in
+    // a step would not notice), then kill its process group
+    for (int i = 0; i < 200 && !g_interrupted.load() && !poll_exit(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     kill(-pid, SIGKILL);
+    untrack_group(pid);
     if (!exited) waitpid(pid, &status, 0);
   }
 };
@@ -115,20 +201,51 @@ void ExternalPolicy::start() {
     close(in_pipe[1]);
     throw std::runtime_error("external policy: pipe failed");
   }
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_adddup2(&fa, in_pipe[0], STDIN_FILENO);
-  posix_spawn_file_actions_adddup2(&fa, out_pipe[1], STDOUT_FILENO);
-  std::string sh = "sh", dash_c = "-c";
-  char* argv[] = {sh.data(), dash_c.data(), command_.data(), nullptr};
-  // own process group, so that a kill also reaches whatever the shell started
-  posix_spawnattr_t attr;
-  posix_spawnattr_init(&attr);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
-  posix_spawnattr_setpgroup(&attr, 0);
-  const int rc = posix_spawn(&proc_->pid, "/bin/sh", &fa, &attr, argv, environ);
-  posix_spawnattr_destroy(&attr);
-  posix_spawn_file_actions_destroy(&fa);
+  // The group's leader is a small shell that runs the command in the background (its stdin moved
+  // to fd 3 and back, as an asynchronous command's stdin would be /dev/null) and waits for it,
+  // exiting with its status. On SIGTERM, which is also its parent-death signal, it kills its whole
+  // group: a parent-death signal reaches only the leader, and the shell that runs the command does
+  // not exec it (Debian's dash forks `python3 policy.py`), so SIGKILL to the leader alone would
+  // leave the policy running.
+  std::string sh = "sh", dash_c = "-c", name = "actionshift-policy";
+  std::string wrapper =
+      "trap 'kill -KILL 0' TERM\n"
+      "exec 3<&0 0</dev/null\n"
+      "/bin/sh -c \"$1\" <&3 3<&- &\n"
+      "exec 3<&- 1>/dev/null\n"
+      "wait $!\n";
+  char* argv[] = {sh.data(), dash_c.data(), wrapper.data(), name.data(), command_.data(), nullptr};
+  const pid_t parent = getpid();
+  int rc = 0;
+  Spawner::instance().run([&] {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      // the child of a multi-threaded process: async-signal-safe calls only, until execve.
+      // Its own process group, so that a kill also reaches whatever the shell started; SIGTERM
+      // (the wrapper then kills its group) when the runner dies, even by SIGKILL (Linux: the
+      // parent-death signal survives execve).
+      setpgid(0, 0);
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != parent) _exit(127);  // the runner died before the line above
+      // the pipes' ends above 2 first, so that neither dup2 overwrites the other (O_CLOEXEC is
+      // cleared on the copies 0 and 1)
+      const int in = fcntl(in_pipe[0], F_DUPFD_CLOEXEC, 3);
+      const int out = fcntl(out_pipe[1], F_DUPFD_CLOEXEC, 3);
+      if (in < 0 || out < 0 || dup2(in, STDIN_FILENO) < 0 || dup2(out, STDOUT_FILENO) < 0) _exit(127);
+      sigset_t none;
+      sigemptyset(&none);
+      sigprocmask(SIG_SETMASK, &none, nullptr);  // the spawner thread blocks every signal
+      execve("/bin/sh", argv, environ);
+      _exit(127);
+    }
+    if (pid < 0) {
+      rc = errno;
+      return;
+    }
+    setpgid(pid, pid);  // also here: a kill(-pid) right after fork must not miss
+    track_group(pid);
+    proc_->pid = pid;
+  });
   close(in_pipe[0]);
   close(out_pipe[1]);
   proc_->to_child = in_pipe[1];
@@ -136,10 +253,7 @@ void ExternalPolicy::start() {
   // non-blocking on our side: every read and write waits in poll() with the protocol's timeouts
   fcntl(proc_->to_child, F_SETFL, fcntl(proc_->to_child, F_GETFL) | O_NONBLOCK);
   fcntl(proc_->from_child, F_SETFL, fcntl(proc_->from_child, F_GETFL) | O_NONBLOCK);
-  if (rc != 0) {
-    proc_->pid = -1;
-    fail("start", std::strerror(rc));
-  }
+  if (rc != 0) fail("start", std::string("fork failed: ") + std::strerror(rc));
   const sim::ObservationLayout& layout = sim::observation_layout(task_);
   nlohmann::json hello = {{"type", "hello"},
                           {"protocol", std::string(kExternalProtocol)},
@@ -214,6 +328,7 @@ void ExternalPolicy::send(const std::string& line, const char* what, double time
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   std::size_t off = 0;
   while (off < data.size()) {
+    if (g_interrupted.load()) fail(what, "interrupted (SIGINT or SIGTERM)");
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0)
       fail(what, "the process did not read its request within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
@@ -246,6 +361,7 @@ std::string ExternalPolicy::receive(double timeout_s, const char* what) {
         fail(what, "protocol error: more than one reply line to one request: '" + excerpt(proc_->buffer) + "'");
       return line;
     }
+    if (g_interrupted.load()) fail(what, "interrupted (SIGINT or SIGTERM)");
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) fail(what, "no reply within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
     pollfd p{proc_->from_child, POLLIN, 0};

@@ -9,8 +9,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <thread>
 
 using namespace actionshift;
 using ::testing::HasSubstr;
@@ -63,6 +66,46 @@ TEST(ExternalPolicy, SilentProcessTimesOut) {
   policy::ExternalPolicy p(kReady + "sleep 30", sim::TaskId::kPickCube, o);
   p.reset();
   expect_runtime_error([&] { p.act(pick_obs()); }, "no reply within 0.300 s (timeout)");
+}
+
+// SIGINT/SIGTERM handlers call interrupt_external_policies(): a policy blocked in a step is not
+// waited for (it was, for the whole step timeout), and its process group is killed at once
+TEST(ExternalPolicy, InterruptStopsABlockedStepAtOnceAndKillsTheGroup) {
+  policy::ExternalOptions o;
+  o.step_timeout_s = 30.0;
+  const std::string pid_file = ::testing::TempDir() + "external_interrupt_" + std::to_string(getpid()) + ".pid";
+  auto p = std::make_unique<policy::ExternalPolicy>(kReady + "sleep 1000 & echo $! > " + pid_file + "; read l; read l; wait",
+                                                    sim::TaskId::kPickCube, o);
+  p->reset();
+  std::thread signal([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    policy::interrupt_external_policies();
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_runtime_error([&] { p->act(pick_obs()); }, "step 0: interrupted (SIGINT or SIGTERM)");
+  signal.join();
+  const auto seconds_since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+  EXPECT_LT(seconds_since(t0), 2.0) << "a blocked step must not wait for the 30 s step timeout";
+  pid_t child = -1;
+  std::ifstream(pid_file) >> child;
+  ASSERT_GT(child, 0);
+  EXPECT_EQ(kill(child, 0), 0);  // the policy's own child, in its group
+  const auto t1 = std::chrono::steady_clock::now();
+  p.reset();  // no 2 s grace after an interrupt: the group is killed at once
+  EXPECT_LT(seconds_since(t1), 1.0);
+  EXPECT_TRUE(policy::external_policies_interrupted());
+  policy::clear_external_interrupt();
+  // the child was killed with the group (a zombie until whoever adopted it reaps it)
+  bool running = true;
+  for (int i = 0; i < 100 && running; ++i) {
+    std::ifstream stat("/proc/" + std::to_string(child) + "/stat");
+    std::string line;
+    running = std::getline(stat, line) && line.substr(line.rfind(')') + 2, 1) != "Z";
+    if (running) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_FALSE(running) << "the policy's child " << child << " survived its group";
+  if (running) kill(child, SIGKILL);
+  std::remove(pid_file.c_str());
 }
 
 TEST(ExternalPolicy, WellBehavedProcessRoundTrip) {

@@ -11,7 +11,8 @@
 ///   -> {"type":"step","t":0,"obs":[42 numbers]}
 ///   <- {"action":[7 numbers]}                            (within the step timeout)
 ///   ...
-///   (end: stdin is closed; the process should exit; its process group is killed after 2 s)
+///   (end: stdin is closed; the process should exit; its process group is killed after 2 s, or at
+///    once after interrupt_external_policies())
 ///
 /// The command runs under `/bin/sh -c`; its stderr is passed through. The process is started
 /// when the policy is constructed (one process per clone, so one per worker thread). The first
@@ -35,6 +36,25 @@
 #include <string_view>
 
 namespace actionshift::policy {
+
+/// Process lifecycle (Linux). Each policy process runs `/bin/sh -c <command>` under a small `sh` wrapper
+/// that leads a process group of its own and waits for it; the wrapper's parent-death signal
+/// (PR_SET_PDEATHSIG) is SIGTERM, on which it SIGKILLs its group, so the policy dies with the runner
+/// even when the runner is killed by SIGKILL. Processes that leave the group (setsid) are not
+/// reached. The group is killed when the policy is destroyed. The functions below are for a
+/// command's signal handlers.
+
+/// Async-signal-safe. Every external policy stops waiting at once: a pending or later request fails
+/// with "interrupted (SIGINT or SIGTERM)", and a destroyed policy's group is killed without the 2 s
+/// grace (a policy blocked in a step would never exit on its own).
+void interrupt_external_policies() noexcept;
+/// Undoes interrupt_external_policies() (before a new job).
+void clear_external_interrupt() noexcept;
+/// Whether interrupt_external_policies() was called since the last clear_external_interrupt().
+bool external_policies_interrupted() noexcept;
+/// Async-signal-safe. SIGKILL to the process group of every live external policy process (for a
+/// handler that is about to end the process).
+void kill_external_policies() noexcept;
 
 /// Protocol identifier sent in the hello message.
 inline constexpr std::string_view kExternalProtocol = "actionshift-policy-v1";
