@@ -124,7 +124,7 @@ class PolicyLeftovers {
       bool alive = false;
       for (const auto& [pid, zombie] : children_of(getpid())) {
         if (zombie) waitpid(pid, nullptr, 0);
-        alive = alive || !zombie;
+        alive = alive || (!zombie && !policy::is_line_process_group(pid));
       }
       if (!alive) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -133,13 +133,18 @@ class PolicyLeftovers {
     for (int round = 0; round < 100; ++round) {
       const std::vector<std::pair<pid_t, bool>> children = children_of(getpid());
       if (children.empty()) break;
+      bool any = false;
       for (const auto& [pid, zombie] : children) {
+        // a live external method (kept for the next job of this command) is not a leftover
+        if (!zombie && policy::is_line_process_group(pid)) continue;
+        any = true;
         if (!zombie) {
           if (getpgid(pid) == pid) kill(-pid, SIGKILL);
           if (kill(pid, SIGKILL) == 0) ++killed;
         }
         waitpid(pid, nullptr, 0);
       }
+      if (!any) break;
     }
     prctl(PR_SET_CHILD_SUBREAPER, 0);
     if (killed > 0)

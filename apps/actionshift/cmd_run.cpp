@@ -1,6 +1,9 @@
 // run, plan (with the real resolver) and calibrate.
 #include "cmd_run.hpp"
 
+#include "actionshift/adapt/plugin.hpp"
+#include "actionshift/eval/external_method.hpp"
+
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/input_file.hpp"
@@ -70,8 +73,24 @@ std::uint64_t read_seed_file(const std::string& path) {
   return std::stoull(s);
 }
 
+namespace {
+// user methods registered by this command (external:<command>): they live as long as the process
+std::vector<adapt::MethodRegistration>& registrations() {
+  static std::vector<adapt::MethodRegistration> r;
+  return r;
+}
+}  // namespace
+
 void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFnOptions& options) {
   check_obs_noise(o.request.obs_noise);
+  if (o.request.method.name.starts_with("external:")) {
+    if (!adapt::find_method_plugin(o.request.method.name))
+      registrations().push_back(eval::register_external_method(o.request.method.name.substr(9),
+                                                               adapt::parse_rung(o.method_rung, "command line", "--method-rung"),
+                                                               o.method_files, o.method_version, options.external));
+  } else if (o.method_rung != "none" || o.method_version != "0" || !o.method_files.empty()) {
+    throw InputError("command line", "--method-rung/--method-version/--method-files", "apply to --method external:<command> only");
+  }
   // syntax errors and repeated keys of --params are named as the option's (the resolver parses it again)
   (void)parse_json_input(o.method_params, "command line", "--params");
   eval::JobRequest q = o.request;
@@ -95,7 +114,11 @@ int run_run(const RunCliOptions& o) {
   eval::EpisodeFnOptions options;
   options.external.step_timeout_s = o.run.step_timeout_s;
   if (!o.run.plan_file.empty()) {
-    const EpisodeFnFactory factory = [options](const eval::JobSpec& job) { return eval::make_episode_fn(job, options); };
+    const EpisodeFnFactory factory = [options](const eval::JobSpec& job) {
+      // a plan's external method is registered from its own job spec (command, rung, version, files)
+      registrations().push_back(eval::register_external_method_of(job, options.external));
+      return eval::make_episode_fn(job, options);
+    };
     if (!o.job.robot.urdf.empty() || !o.job.robot.packages.empty() || !o.job.policy_files.empty() || !o.job.calibration.empty() ||
         o.job.request.obs_noise != 0.0) {
       std::cerr << "actionshift: error: --plan: " << o.run.plan_file

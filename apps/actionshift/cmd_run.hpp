@@ -25,6 +25,10 @@ struct CliJobOptions {
   std::vector<std::string> policy_files;  // --policy-files: files of an external policy (content hashed into the id)
   std::string calibration;         // --calibration: response calibration file instead of the built-in one
   std::string seed_file;           // --seed-file: the experimental seed read from a file (an evaluator's undisclosed seed)
+  // --method external:<command>: its declared rung, version and files (docs/methods.md)
+  std::string method_rung{"none"};
+  std::string method_version{"0"};
+  std::vector<std::string> method_files;
 };
 // The job these options name, and the run-time options of its episode function (the calibration
 // file, read and checked against the job's task and profile). Throws actionshift::InputError.

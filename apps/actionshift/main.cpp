@@ -246,6 +246,14 @@ int main(int argc, char** argv) {
                     "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
                     "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");
     add_robot_options(cmd, j.robot, /*makes_jobs=*/true);
+    cmd->add_option("--method-rung", j.method_rung,
+                    "--method external:<command> only: the rung it claims, pool, grammar or none (what the runner hands it;\n"
+                    "docs/methods.md)")
+        ->capture_default_str();
+    cmd->add_option("--method-version", j.method_version, "--method external:<command> only: its declared version (in the job id)")
+        ->capture_default_str();
+    cmd->add_option("--method-files", j.method_files,
+                    "--method external:<command> only: its script, weights, configuration (their content enters the job id)");
     cmd->add_option("--policy-files", j.policy_files,
                     "Files of an external:<command> backbone (script, weights, config): their content hash enters the\n"
                     "job id, so editing the policy makes a new job instead of reusing old results");

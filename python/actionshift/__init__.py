@@ -51,7 +51,7 @@ __all__ = [
     "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
     "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
     "method_rung", "PoolBelief", "ResponseModel",
-    "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
+    "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_method", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
 ]
 
 PROFILES = ("maniskill", "ideal")
@@ -384,6 +384,52 @@ def serve_policy(policy, stdin=None, stdout=None):
             action = _np.asarray(current(_np.asarray(msg["obs"], dtype=_np.float64)), dtype=_np.float64)
             fout.write(_json.dumps({"action": [float(x) for x in action.reshape(-1)]}) + "\n")
             fout.flush()
+
+
+def serve_method(method, stdin=None, stdout=None):
+    """Serve a method object (as ``evaluate(method=...)`` takes one: ``setup``, ``begin_episode``,
+    ``encode``, ``observe``) over the external-method protocol (actionshift-method-v1,
+    docs/methods.md) on stdin/stdout, so ``actionshift run --method "external:python3 my_method.py"
+    --method-rung RUNG`` runs it in its own process. ``setup(inputs)`` is called before each episode
+    with the inputs of the hello (those of the rung the command line declared)."""
+    fin = stdin or _sys.stdin
+    fout = stdout or _sys.stdout
+    inputs = None
+    for line in fin:
+        line = line.strip()
+        if not line:
+            continue
+        msg = _json.loads(line)
+        kind = msg.get("type")
+        if kind == "hello":
+            given = msg.get("inputs") or {}
+            cal = given.get("calibration")
+            inputs = {"task": msg.get("task"), "rung": msg.get("rung"), "params": msg.get("params") or {},
+                      "pool": None if given.get("pool") is None else [Contract.from_json(_json.dumps(c)) for c in given["pool"]],
+                      "calibration": None if cal is None else ResponseModel(cal["alpha"], cal["sigma"], cal["gripper_alpha"],
+                                                                             cal["gripper_sigma"]),
+                      "grammar": given.get("grammar")}
+            fout.write('{"type":"ready"}\n')
+            fout.flush()
+        elif kind == "begin_episode":
+            if hasattr(method, "setup"):
+                method.setup(inputs)
+            method.begin_episode(msg["seed"])
+        elif kind == "encode":
+            out = method.encode(_np.asarray(msg["canonical"], dtype=_np.float64),
+                                _np.asarray(msg["R"], dtype=_np.float64).reshape(3, 3))
+            probe = False
+            if isinstance(out, tuple):
+                out, probe = out
+            raw = [float(x) for x in _np.asarray(out, dtype=_np.float64).reshape(-1)]
+            fout.write(_json.dumps({"raw": raw, "probe": bool(probe)}) + "\n")
+            fout.flush()
+        elif kind == "observe":
+            if hasattr(method, "observe_fingers") and msg.get("finger_delta") is not None:
+                method.observe_fingers(msg["finger_delta"])
+            if hasattr(method, "observe"):
+                method.observe(_np.asarray(msg["raw"], dtype=_np.float64), _np.asarray(msg["response"], dtype=_np.float64),
+                               _np.asarray(msg["R"], dtype=_np.float64).reshape(3, 3))
 
 
 def _register_gymnasium():

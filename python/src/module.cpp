@@ -1538,6 +1538,23 @@ PYBIND11_MODULE(_native, m) {
   py::class_<adapt::ResponseModel>(m, "ResponseModel",
                                    "A task's calibrated response model: response_c ~ alpha_c * canonical_c, noise sigma_c "
                                    "(docs/reference.md); what the pool and grammar rungs receive.")
+      .def(py::init([](py::handle alpha, py::handle sigma, double gripper_alpha, double gripper_sigma) {
+             adapt::ResponseModel r;
+             const auto a = to_vec<kPoseDim>(alpha, "alpha");
+             const auto s = to_vec<kPoseDim>(sigma, "sigma");
+             for (int c = 0; c < kPoseDim; ++c) {
+               r.alpha[static_cast<std::size_t>(c)] = a[c];
+               r.sigma[static_cast<std::size_t>(c)] = s[c];
+             }
+             r.gripper_alpha = gripper_alpha;
+             r.gripper_sigma = gripper_sigma;
+             try {
+               r.validate();
+             } catch (const std::invalid_argument& e) {
+               value_error(std::string("ResponseModel: ") + e.what());
+             }
+             return r;
+           }), py::arg("alpha"), py::arg("sigma"), py::arg("gripper_alpha") = 0.0, py::arg("gripper_sigma") = 0.0)
       .def_property_readonly("alpha", [](const adapt::ResponseModel& r) { return vec_out(r.alpha); })
       .def_property_readonly("sigma", [](const adapt::ResponseModel& r) { return vec_out(r.sigma); })
       .def_readonly("gripper_alpha", &adapt::ResponseModel::gripper_alpha)

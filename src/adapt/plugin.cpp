@@ -113,7 +113,12 @@ MethodRegistration::~MethodRegistration() {
 
 MethodRegistration register_method(MethodPlugin plugin, const std::string& kind) {
   const std::string src = "method " + printable_input(plugin.name);
-  if (!is_name(plugin.name))
+  const bool external_name = kind == "external" && plugin.name.starts_with("external:") && plugin.name.size() > 9 &&
+                             plugin.name.size() <= 4096 &&
+                             std::none_of(plugin.name.begin(), plugin.name.end(), [](char c) {
+                               return c == '{' || c == '}' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+                             });
+  if (!is_name(plugin.name) && !external_name)
     throw InputError(src, "name", "expected a name of [a-z0-9_.-] starting with a letter, at most 64 characters");
   if (is_builtin(plugin.name)) throw InputError(src, "name", "is a built-in method's name; choose another");
   if (plugin.version.empty() || plugin.version.size() > 64 ||

@@ -72,7 +72,9 @@ void validate_job(const JobSpec& job, const std::string& src) {
   check_token(job.split.name, src, "split.name");
   check_hash(job.split.sha256, src, "split.sha256");
   if (job.split.contracts <= 0) throw InputError(src, "split.contracts", "must be > 0 (got " + std::to_string(job.split.contracts) + ")");
-  check_token(job.method, src, "method.name");
+  // an external method is named by its command (`external:<command>`), like an external backbone
+  if (!(job.method_plugin && job.method_plugin->kind == "external" && job.method.starts_with("external:")))
+    check_token(job.method, src, "method.name");
   if (job.method_plugin) {
     const auto& m = *job.method_plugin;
     if (m.kind != "cpp" && m.kind != "python" && m.kind != "external")

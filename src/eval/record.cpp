@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 #include <cmath>
 #include <set>
 
@@ -79,7 +81,12 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
     throw InputError(src, "task", "not a task of this benchmark (got " + quote_input(r.task, '"') + ")");
   }
   if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got " + quote_input(r.split, '"') + ")");
-  if (!detail::is_token(r.method)) throw InputError(src, "method", "expected a name of [a-z0-9_.-] (got " + quote_input(r.method, '"') + ")");
+  // a user method in another process is named by its command, `external:<command>` (docs/methods.md)
+  const bool external = r.method.starts_with("external:") && r.method.size() > 9 && r.method.size() <= 512 &&
+                        std::none_of(r.method.begin(), r.method.end(),
+                                     [](char c) { return c == '{' || c == '}' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+  if (!external && !detail::is_token(r.method))
+    throw InputError(src, "method", "expected a name of [a-z0-9_.-] or external:<command> (got " + quote_input(r.method, '"') + ")");
   if (r.method_variant.empty() || r.method_variant.size() > 512)
     throw InputError(src, "method_variant", "must be a label of 1 to 512 characters");
   for (char c : r.method_variant)

@@ -1,5 +1,6 @@
 // external-process policy: JSON lines over a child's stdin/stdout with timeouts
 #include "actionshift/policy/external.hpp"
+#include "actionshift/policy/line_process.hpp"
 
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -96,6 +97,13 @@ class Spawner {
 };
 }  // namespace
 
+bool is_line_process_group(int pgid) noexcept {
+  if (pgid <= 0) return false;
+  for (const auto& slot : g_groups)
+    if (slot.load() == pgid) return true;
+  return false;
+}
+
 void interrupt_external_policies() noexcept { g_interrupted.store(true); }
 void clear_external_interrupt() noexcept { g_interrupted.store(false); }
 bool external_policies_interrupted() noexcept { return g_interrupted.load(); }
@@ -106,7 +114,7 @@ void kill_external_policies() noexcept {
   }
 }
 
-struct ExternalPolicy::Process {
+struct LineProcess::Impl {
   pid_t pid{-1};
   int to_child{-1};    // child's stdin
   int from_child{-1};  // child's stdout
@@ -125,7 +133,7 @@ struct ExternalPolicy::Process {
     if (WIFSIGNALED(status)) return "process killed by signal " + std::to_string(WTERMSIG(status));
     return "process ended";
   }
-  ~Process() {
+  ~Impl() {
     if (to_child >= 0) close(to_child);
     if (from_child >= 0) close(from_child);
     if (pid <= 0) return;
@@ -187,19 +195,20 @@ ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOp
   start();
 }
 
-ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<Process> proc)
+ExternalPolicy::ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<LineProcess> proc)
     : command_(std::move(command)), task_(task), options_(options), proc_(std::move(proc)) {}
 
-void ExternalPolicy::start() {
+LineProcess::LineProcess(std::string command, std::string role)
+    : command_(std::move(command)), role_(std::move(role)), impl_(std::make_unique<Impl>()) {
+  if (command_.empty()) throw std::invalid_argument(role_ + ": empty command");
   static std::once_flag ignore_sigpipe;
   std::call_once(ignore_sigpipe, [] { std::signal(SIGPIPE, SIG_IGN); });
-  proc_ = std::make_unique<Process>();
   int in_pipe[2], out_pipe[2];
-  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw std::runtime_error("external policy: pipe failed");
+  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw std::runtime_error(role_ + ": pipe failed");
   if (pipe2(out_pipe, O_CLOEXEC) != 0) {
     close(in_pipe[0]);
     close(in_pipe[1]);
-    throw std::runtime_error("external policy: pipe failed");
+    throw std::runtime_error(role_ + ": pipe failed");
   }
   // The group's leader is a small shell that runs the command in the background (its stdin moved
   // to fd 3 and back, as an asynchronous command's stdin would be /dev/null) and waits for it,
@@ -244,16 +253,22 @@ void ExternalPolicy::start() {
     }
     setpgid(pid, pid);  // also here: a kill(-pid) right after fork must not miss
     track_group(pid);
-    proc_->pid = pid;
+    impl_->pid = pid;
   });
   close(in_pipe[0]);
   close(out_pipe[1]);
-  proc_->to_child = in_pipe[1];
-  proc_->from_child = out_pipe[0];
+  impl_->to_child = in_pipe[1];
+  impl_->from_child = out_pipe[0];
   // non-blocking on our side: every read and write waits in poll() with the protocol's timeouts
-  fcntl(proc_->to_child, F_SETFL, fcntl(proc_->to_child, F_GETFL) | O_NONBLOCK);
-  fcntl(proc_->from_child, F_SETFL, fcntl(proc_->from_child, F_GETFL) | O_NONBLOCK);
+  fcntl(impl_->to_child, F_SETFL, fcntl(impl_->to_child, F_GETFL) | O_NONBLOCK);
+  fcntl(impl_->from_child, F_SETFL, fcntl(impl_->from_child, F_GETFL) | O_NONBLOCK);
   if (rc != 0) fail("start", std::string("fork failed: ") + std::strerror(rc));
+}
+
+LineProcess::~LineProcess() = default;
+
+void ExternalPolicy::start() {
+  proc_ = std::make_unique<LineProcess>(command_, "external policy");
   const sim::ObservationLayout& layout = sim::observation_layout(task_);
   nlohmann::json hello = {{"type", "hello"},
                           {"protocol", std::string(kExternalProtocol)},
@@ -290,39 +305,43 @@ void ExternalPolicy::ensure_started() {
   if (!proc_) start();
 }
 
-void ExternalPolicy::fail(const std::string& what, const std::string& reason) {
-  throw std::runtime_error("external policy '" + command_ + "': " + what + ": " + reason);
+void LineProcess::fail(const std::string& what, const std::string& reason) const {
+  throw std::runtime_error(role_ + " '" + command_ + "': " + what + ": " + reason);
 }
 
-bool ExternalPolicy::read_some(const char* what) {
+void ExternalPolicy::fail(const std::string& what, const std::string& reason) { proc_->fail(what, reason); }
+void ExternalPolicy::send(const std::string& line, const char* what, double timeout_s) { proc_->send(line, what, timeout_s); }
+std::string ExternalPolicy::receive(double timeout_s, const char* what) { return proc_->receive(timeout_s, what); }
+
+bool LineProcess::read_some(const char* what) {
   char chunk[4096];
   for (;;) {
-    const ssize_t n = read(proc_->from_child, chunk, sizeof chunk);
+    const ssize_t n = read(impl_->from_child, chunk, sizeof chunk);
     if (n > 0) {
-      proc_->buffer.append(chunk, static_cast<std::size_t>(n));
-      if (proc_->buffer.size() > kMaxReplyBytes) fail(what, "reply line longer than 1 MiB");
+      impl_->buffer.append(chunk, static_cast<std::size_t>(n));
+      if (impl_->buffer.size() > kMaxReplyBytes) fail(what, "reply line longer than 1 MiB");
       return true;
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return false;
     // end of stream: the process closed stdout or died; wait briefly for its status
-    for (int i = 0; i < 50 && !proc_->poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    fail(what, proc_->exited ? proc_->exit_text() + " before replying" : std::string("process closed its stdout"));
+    for (int i = 0; i < 50 && !impl_->poll_exit(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    fail(what, impl_->exited ? impl_->exit_text() + " before replying" : std::string("process closed its stdout"));
   }
 }
 
-void ExternalPolicy::check_no_pending_output(const char* what) {
+void LineProcess::check_no_pending_output(const char* what) {
   // the protocol is strictly one reply per step request: whatever arrived since the last reply was
   // not asked for (a second reply, or a reply to a reset), and would make every later reply lag
-  pollfd p{proc_->from_child, POLLIN, 0};
-  while (proc_->buffer.empty() && poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLHUP | POLLERR)) != 0) {
+  pollfd p{impl_->from_child, POLLIN, 0};
+  while (impl_->buffer.empty() && poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLHUP | POLLERR)) != 0) {
     if (!read_some(what)) break;
   }
-  if (!proc_->buffer.empty())
-    fail(what, "protocol error: output that no request asked for (an extra reply?): '" + excerpt(proc_->buffer) + "'");
+  if (!impl_->buffer.empty())
+    fail(what, "protocol error: output that no request asked for (an extra reply?): '" + excerpt(impl_->buffer) + "'");
 }
 
-void ExternalPolicy::send(const std::string& line, const char* what, double timeout_s) {
+void LineProcess::send(const std::string& line, const char* what, double timeout_s) {
   check_no_pending_output(what);
   const std::string data = line + "\n";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
@@ -333,38 +352,38 @@ void ExternalPolicy::send(const std::string& line, const char* what, double time
     if (left.count() <= 0)
       fail(what, "the process did not read its request within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
     // watch stdout too: a process that writes instead of reading would otherwise block both sides
-    pollfd p[2] = {{proc_->to_child, POLLOUT, 0}, {proc_->from_child, POLLIN, 0}};
+    pollfd p[2] = {{impl_->to_child, POLLOUT, 0}, {impl_->from_child, POLLIN, 0}};
     const int r = poll(p, 2, static_cast<int>(std::min<long long>(left.count(), 100)));
     if (r < 0 && errno != EINTR) fail(what, std::string("poll failed: ") + std::strerror(errno));
     if (r <= 0) continue;
     if ((p[1].revents & (POLLIN | POLLHUP | POLLERR)) != 0 && read_some(what))
-      fail(what, "protocol error: output before the request was read (an extra reply?): '" + excerpt(proc_->buffer) + "'");
+      fail(what, "protocol error: output before the request was read (an extra reply?): '" + excerpt(impl_->buffer) + "'");
     if ((p[0].revents & (POLLOUT | POLLERR | POLLHUP)) == 0) continue;
-    const ssize_t n = write(proc_->to_child, data.data() + off, data.size() - off);
+    const ssize_t n = write(impl_->to_child, data.data() + off, data.size() - off);
     if (n < 0) {
       if (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK) continue;
-      if (proc_->poll_exit()) fail(what, proc_->exit_text());
+      if (impl_->poll_exit()) fail(what, impl_->exit_text());
       fail(what, std::string("write failed: ") + std::strerror(errno));
     }
     off += static_cast<std::size_t>(n);
   }
 }
 
-std::string ExternalPolicy::receive(double timeout_s, const char* what) {
+std::string LineProcess::receive(double timeout_s, const char* what) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (true) {
-    const auto nl = proc_->buffer.find('\n');
+    const auto nl = impl_->buffer.find('\n');
     if (nl != std::string::npos) {
-      std::string line = proc_->buffer.substr(0, nl);
-      proc_->buffer.erase(0, nl + 1);
-      if (!proc_->buffer.empty())
-        fail(what, "protocol error: more than one reply line to one request: '" + excerpt(proc_->buffer) + "'");
+      std::string line = impl_->buffer.substr(0, nl);
+      impl_->buffer.erase(0, nl + 1);
+      if (!impl_->buffer.empty())
+        fail(what, "protocol error: more than one reply line to one request: '" + excerpt(impl_->buffer) + "'");
       return line;
     }
     if (g_interrupted.load()) fail(what, "interrupted (SIGINT or SIGTERM)");
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) fail(what, "no reply within " + std::to_string(timeout_s).substr(0, 5) + " s (timeout)");
-    pollfd p{proc_->from_child, POLLIN, 0};
+    pollfd p{impl_->from_child, POLLIN, 0};
     const int r = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 100)));
     if (r < 0 && errno != EINTR) fail(what, std::string("poll failed: ") + std::strerror(errno));
     if (r <= 0) continue;

@@ -27,6 +27,7 @@
 /// being written is a protocol error (a flooding process cannot make replies lag requests). SIGPIPE is ignored process-wide once an external policy is
 /// created (writes to a dead process then fail with EPIPE instead of killing the caller).
 
+#include "actionshift/policy/line_process.hpp"
 #include "actionshift/policy/policy.hpp"
 
 #include <chrono>
@@ -90,21 +91,18 @@ class ExternalPolicy final : public Policy {
   std::unique_ptr<Policy> clone() const override;
 
  private:
-  struct Process;
-  ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<Process> proc);
+  ExternalPolicy(std::string command, sim::TaskId task, ExternalOptions options, std::unique_ptr<LineProcess> proc);
   void start();            // spawn the process and perform the hello (sets proc_)
   void ensure_started();   // start() again if the process was handed to a clone
   void send(const std::string& line, const char* what, double timeout_s);
   std::string receive(double timeout_s, const char* what);
-  bool read_some(const char* what);
-  void check_no_pending_output(const char* what);
   [[noreturn]] void fail(const std::string& what, const std::string& reason);
 
   std::string command_;
   sim::TaskId task_;
   ExternalOptions options_;
   mutable std::mutex handover_mutex_;     // clone() may run on several threads at once
-  mutable std::unique_ptr<Process> proc_;  // null once handed to a clone (until the next use)
+  mutable std::unique_ptr<LineProcess> proc_;  // null once handed to a clone (until the next use)
   std::int64_t episode_{-1};
   int step_{0};
 };
