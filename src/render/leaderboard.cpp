@@ -172,7 +172,8 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
   md << "# Leaderboard\n\n" << intro << "\n\n"
      << "Made by `" << command << "` at commit `" << commit << "` from " << records << " records in " << o.results_dirs.size()
      << " director" << (o.results_dirs.size() == 1 ? "y" : "ies")
-     << "; each job's profile, seeds and episode counts are in leaderboard.json (`comparison.cells[].per_seed`, `jobs`).\n\n";
+     << "; the seeds, episode counts and job ids of every cell are in leaderboard.json (`board[].cells[].per_seed`, `jobs`), "
+        "each job's profile in its summary.\n\n";
   html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>ActionShift leaderboard</title><style>"
        << "body{font-family:sans-serif;margin:2em;max-width:90em}table{border-collapse:collapse;margin-bottom:1.5em}"
        << "td,th{border:1px solid #ccc;padding:.3em .6em;text-align:right}td:first-child,th:first-child{text-align:left}"
@@ -222,7 +223,7 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
     for (const auto& [id, c] : row.cells) {
       const auto k = row.comparisons.find(id);
       entry["cells"].push_back({{"task", std::get<0>(id)}, {"split", std::get<1>(id)}, {"backbone", std::get<2>(id)},
-                                {"success_once", c.at("success_once")},
+                                {"success_once", c.at("success_once")}, {"per_seed", c.at("per_seed")}, {"jobs", c.at("jobs")},
                                 {"difference", k != row.comparisons.end() ? k->second.at("difference") : json(nullptr)},
                                 {"promotion", k != row.comparisons.end() ? k->second.at("promotion") : json(nullptr)}});
     }
@@ -282,7 +283,9 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
   r.markdown_path = (fs::path(o.out_dir) / "leaderboard.md").string();
   r.html_path = (fs::path(o.out_dir) / "leaderboard.html").string();
   r.json_path = (fs::path(o.out_dir) / "leaderboard.json").string();
-  json doc = {{"reference", o.reference}, {"command", o.command}, {"commit", commit}, {"board", board}, {"comparison", cmp}};
+  // the board's numbers and what they were computed from (the full comparison is `actionshift compare`'s)
+  json doc = {{"reference", o.reference}, {"command", command}, {"commit", commit}, {"inputs", cmp.at("inputs")},
+              {"bootstrap", cmp.at("bootstrap")}, {"board", board}};
   write_text(r.markdown_path, md.str());
   write_text(r.html_path, html.str());
   write_text(r.json_path, doc.dump(1) + "\n");

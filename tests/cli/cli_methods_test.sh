@@ -85,6 +85,59 @@ else
   echo "skipped: the external-method case needs the Python module"
 fi
 
+# a hostile external method (rung none) logs everything it can reach: the protocol's messages, its
+# environment and the command lines of its ancestors up to the runner. None of it names a contract of
+# the split or the job's seed (given by --seed-file, so it is not on the runner's command line either)
+cat > "$TMP/hostile.py" <<'PY'
+import json, os, sys
+log = open(os.environ["HOSTILE_LOG"], "w")
+def ancestors():
+    pid, out = os.getpid(), []
+    for _ in range(6):
+        try:
+            out.append(open(f"/proc/{pid}/cmdline", "rb").read().decode(errors="replace"))
+            pid = int(open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[1])
+        except OSError:
+            break
+    return out
+log.write(json.dumps({"environ": dict(os.environ), "cmdlines": ancestors(), "argv": sys.argv}) + "\n")
+for line in sys.stdin:
+    log.write(line)
+    msg = json.loads(line)
+    if msg["type"] == "hello":
+        print('{"type":"ready"}', flush=True)
+    elif msg["type"] == "encode":
+        print(json.dumps({"raw": msg["canonical"], "probe": False}), flush=True)
+PY
+echo 987654321987 > "$TMP/seed"
+run env HOSTILE_LOG="$TMP/hostile.log" "$AS" run --task pick_cube --split reference_seen --backbone expert --episodes 9 \
+  --threads 1 --progress off --seed-file "$TMP/seed" --method "external:python3 $TMP/hostile.py" --out "$TMP/hostile"
+expect_rc 0 "the hostile external method runs"
+python3 - "$TMP/hostile.log" "$SRC/manifests/reference_seen.json" <<'PY' && ok || bad "a hostile external method reached the contract or the seed"
+import json, sys
+text = open(sys.argv[1]).read()
+split = json.load(open(sys.argv[2]))
+secrets = {"987654321987"}
+for c in split["test"]:
+    secrets.add(json.dumps(c, sort_keys=True, separators=(",", ":")))
+leaks = [s for s in secrets if s in text]
+assert not leaks, leaks
+lines = [json.loads(l) for l in text.splitlines()]
+hello = next(l for l in lines if l.get("type") == "hello")
+assert hello["rung"] == "none" and hello["inputs"] == {"pool": None, "calibration": None, "grammar": None}, hello
+assert set(hello) == {"type", "protocol", "task", "rung", "params", "inputs"}, set(hello)
+keys = {k for l in lines[1:] for k in l}
+assert keys <= {"type", "seed", "canonical", "R", "raw", "response", "finger_delta", "protocol", "task", "rung", "params", "inputs"}, keys
+assert not any("contract" in k for k in keys)
+PY
+# contract hashes of the split appear nowhere either (the records name them; the method never sees them)
+python3 - "$TMP/hostile.log" "$TMP/hostile" <<'PY' && ok || bad "a contract hash reached the hostile method"
+import glob, json, sys
+text = open(sys.argv[1]).read()
+hashes = {json.loads(l)["contract_sha256"] for f in glob.glob(sys.argv[2] + "/*.jsonl") for l in open(f)}
+assert len(hashes) >= 2 and not any(h in text for h in hashes)
+PY
+
 # bad input: one line, exit 2
 run "$AS" report "$TMP/r" --leaderboard --reference no_such_method --out "$TMP/board2"
 expect_rc 2 "unknown reference"

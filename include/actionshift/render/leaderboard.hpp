@@ -29,8 +29,8 @@ struct LeaderboardResult {
 };
 
 /// Writes `<out>/leaderboard.md` (an overall table, then one table per (task, split) with a column pair per
-/// backbone), `<out>/leaderboard.html` and `<out>/leaderboard.json` (the
-/// comparison JSON of `actionshift compare` plus each row's rung and kind). Rows are sorted by their
+/// backbone), `<out>/leaderboard.html` and `<out>/leaderboard.json` (per row: its
+/// rung, kind and each cell's Wilson interval, per-seed counts, job ids, paired difference and verdict). Rows are sorted by their
 /// mean success over the cells they have; a method's rung is the built-in's or, for a user method, the
 /// one its job declares. Throws InputError for a directory without records, a reference label found in
 /// no cell, or as eval::compare_records.
