@@ -88,12 +88,18 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
   if (o.results_dirs.empty()) throw InputError("leaderboard", "results", "name at least one results directory");
   // the labels and cells present, to choose the pairs (every label against the reference where both ran)
   std::map<std::string, std::set<CellId>> where;
+  std::set<std::string> profiles;
+  std::set<std::uint64_t> seeds;
   std::size_t records = 0;
   for (const auto& dir : o.results_dirs) {
     const eval::ResultSet rs = eval::load_results(dir);
     if (rs.records.empty()) throw InputError(dir, "", eval::no_records_reason(rs));
     records += rs.records.size();
-    for (const auto& r : rs.records) where[r.method_variant].insert({r.task, r.split, r.backbone});
+    for (const auto& r : rs.records) {
+      where[r.method_variant].insert({r.task, r.split, r.backbone});
+      profiles.insert(r.profile);
+      seeds.insert(r.seed);
+    }
   }
   const auto ref = where.find(o.reference);
   if (ref == where.end()) {
@@ -161,6 +167,19 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
     return d.at("estimate").get<double>() > 0 ? "up" : "down";
   };
 
+  std::int64_t min_n = -1, max_n = 0;
+  for (const auto& row : order)
+    for (const auto& [id, c] : row.cells) {
+      const auto n = c.at("episodes").get<std::int64_t>();
+      min_n = min_n < 0 ? n : std::min(min_n, n);
+      max_n = std::max(max_n, n);
+    }
+  std::string profile_list, seed_list;
+  for (const auto& p : profiles) profile_list += (profile_list.empty() ? "" : ", ") + p;
+  for (const auto& sd : seeds) seed_list += (seed_list.empty() ? "" : ", ") + std::to_string(sd);
+  const std::string runs = "Simulator profile " + profile_list + "; seeds " + seed_list + "; " +
+                           (min_n == max_n ? std::to_string(max_n) : std::to_string(min_n) + " to " + std::to_string(max_n)) +
+                           " episodes per cell (pooled over the seeds).";
   std::ostringstream md, html;
   const std::string intro =
       "Every method label of the results against `" + o.reference + "`, on each (task, split, backbone) where `" + o.reference +
@@ -171,15 +190,15 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
       "too narrow (docs/formats.md, \"Comparison\").";
   md << "# Leaderboard\n\n" << intro << "\n\n"
      << "Made by `" << command << "` at commit `" << commit << "` from " << records << " records in " << o.results_dirs.size()
-     << " director" << (o.results_dirs.size() == 1 ? "y" : "ies")
-     << "; the seeds, episode counts and job ids of every cell are in leaderboard.json (`board[].cells[].per_seed`, `jobs`), "
-        "each job's profile in its summary.\n\n";
+     << " director" << (o.results_dirs.size() == 1 ? "y" : "ies") << ". " << runs
+     << " Per-seed counts and the job ids of every cell are in leaderboard.json (`board[].cells[].per_seed`, `jobs`).\n\n";
   html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>ActionShift leaderboard</title><style>"
        << "body{font-family:sans-serif;margin:2em;max-width:90em}table{border-collapse:collapse;margin-bottom:1.5em}"
        << "td,th{border:1px solid #ccc;padding:.3em .6em;text-align:right}td:first-child,th:first-child{text-align:left}"
        << ".ref{background:#eef}.up{color:#060;font-weight:bold}.down{color:#a00;font-weight:bold}small{color:#555}</style></head><body>"
        << "<h1>Leaderboard</h1><p>" << detail::xml_escape(intro) << "</p><p><small>Made by <code>" << detail::xml_escape(command)
-       << "</code> at commit <code>" << detail::xml_escape(commit) << "</code> from " << records << " records.</small></p>";
+       << "</code> at commit <code>" << detail::xml_escape(commit) << "</code> from " << records << " records. "
+       << detail::xml_escape(runs) << "</small></p>";
 
   // overall: mean success per backbone and how the paired differences fall
   md << "## Overall\n\n| method | rung | kind |";
