@@ -185,7 +185,9 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
       "Every method label of the results against `" + o.reference + "`, on each (task, split, backbone) where `" + o.reference +
       "` ran. Success is `success_once` with its 95 % Wilson interval and n; Δ is the paired bootstrap difference from `" +
       o.reference + "` with its 95 % interval over the same episodes (same seed, contract and initial state), followed by the "
-      "promotion verdict of `actionshift gate promote`. A difference whose interval includes 0 does not rank two methods. The "
+      "promotion verdict of `actionshift gate promote`; \"paper\" is the paper's success for the cell (Table 5 for the PPO "
+      "backbone; configs/paper/numbers.json), set beside ours for the paper's methods only. A difference whose interval "
+      "includes 0 does not rank two methods. The "
       "intervals treat episodes as independent, but the contracts of one block share their initial state, so they are somewhat "
       "too narrow (docs/formats.md, \"Comparison\").";
   md << "# Leaderboard\n\n" << intro << "\n\n"
@@ -257,12 +259,12 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
     md << "## " << title << "\n\n| method |";
     html << "<h2>" << detail::xml_escape(title) << "</h2><table><tr><th>method</th>";
     for (const auto& b : bbs) {
-      md << " " << md_cell(b) << " | Δ vs " << md_cell(o.reference) << ", " << md_cell(b) << " |";
-      html << "<th>" << detail::xml_escape(b) << "</th><th>&Delta; vs " << detail::xml_escape(o.reference) << ", "
+      md << " " << md_cell(b) << " | paper | Δ vs " << md_cell(o.reference) << ", " << md_cell(b) << " |";
+      html << "<th>" << detail::xml_escape(b) << "</th><th>paper</th><th>&Delta; vs " << detail::xml_escape(o.reference) << ", "
            << detail::xml_escape(b) << "</th>";
     }
     md << "\n|---|";
-    for (std::size_t i = 0; i < bbs.size(); ++i) md << "---|---|";
+    for (std::size_t i = 0; i < bbs.size(); ++i) md << "---|---|---|";
     md << "\n";
     html << "</tr>";
     for (const auto& row : order) {
@@ -278,8 +280,12 @@ LeaderboardResult write_leaderboard(const LeaderboardOptions& o) {
         const auto k = row.comparisons.find(id);
         const std::string s = cell != row.cells.end() ? success_text(cell->second.at("success_once")) : "–";
         const std::string d = k != row.comparisons.end() ? delta_text(k->second) : (is_ref ? "reference" : "–");
-        md << " " << s << " | " << md_cell(d) << " |";
-        html << "<td>" << detail::xml_escape(s) << "</td><td><span class=\""
+        // the paper's success for this cell (configs/paper/numbers.json, through compare), when it has one
+        std::string paper = "–";
+        if (cell != row.cells.end() && cell->second.at("paper").contains("success_once"))
+          paper = r3(cell->second.at("paper").at("success_once").at("value").get<double>());
+        md << " " << s << " | " << paper << " | " << md_cell(d) << " |";
+        html << "<td>" << detail::xml_escape(s) << "</td><td>" << paper << "</td><td><span class=\""
              << (k != row.comparisons.end() ? delta_class(k->second) : "") << "\">" << detail::xml_escape(d) << "</span></td>";
       }
       md << "\n";

@@ -44,8 +44,9 @@ expect_out "4 methods, 1 cells" "leaderboard counts"
 grep -qF "| $LABEL | pool | cpp |" "$TMP/board/leaderboard.md" && ok || bad "the user method is a row with its rung and kind"
 grep -qF "| **entropy_probes** | pool | built-in |" "$TMP/board/leaderboard.md" && ok || bad "the reference row"
 grep -qF "## pick_cube / reference_seen" "$TMP/board/leaderboard.md" && ok || bad "the cell's table"
-grep -qE "^\| separation_probes\{amplitude=0.5,budget=6\} \| 0\.[0-9]{3} \[0\.[0-9]{3}, [01]\.[0-9]{3}\] n=9 \| [-+][01]\.[0-9]{3} \[" "$TMP/board/leaderboard.md" \
-  && ok || bad "the user method's success interval and paired difference in its cell"
+grep -qE "^\| separation_probes\{amplitude=0.5,budget=6\} \| 0\.[0-9]{3} \[0\.[0-9]{3}, [01]\.[0-9]{3}\] n=9 \| – \| [-+][01]\.[0-9]{3} \[" "$TMP/board/leaderboard.md" \
+  && ok || bad "the user method's success interval and paired difference in its cell (no paper number)"
+grep -qE "^\| fixed_probes \| .* n=9 \| 0\.[0-9]{3} \|" "$TMP/board/leaderboard.md" && ok || bad "the paper's number beside a paper method"
 grep -qF "separation_probes{amplitude=0.5,budget=6}</code>" "$TMP/board/leaderboard.html" && ok || bad "the HTML row"
 python3 -c "import json,sys; b=json.load(open(sys.argv[1])); assert len(b['board'])==4 and b['reference']=='entropy_probes'" \
   "$TMP/board/leaderboard.json" && ok || bad "leaderboard.json"
