@@ -11,6 +11,8 @@
 #include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/store.hpp"
 #include "actionshift/eval/summary.hpp"
+#include "actionshift/adapt/plugin.hpp"
+#include "actionshift/eval/external_method.hpp"
 #include "actionshift/policy/external.hpp"
 
 #include <nlohmann/json.hpp>
@@ -395,6 +397,20 @@ unsigned cluster_max_array_size() {
 int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
     const eval::Experiment ex = eval::load_experiment(o.experiment_file);
+    // an external method of the experiment is registered while its jobs are made (its identity is hashed
+    // into them; the jobs then carry its command, rung, version and files)
+    std::vector<adapt::MethodRegistration> external;
+    for (std::size_t i = 0; i < ex.methods.size(); ++i) {
+      const eval::MethodEntry& m = ex.methods[i];
+      if (!m.name.starts_with("external:") || adapt::find_method_plugin(m.name)) continue;
+      const std::string field = "methods[" + std::to_string(i) + "]";
+      try {
+        external.push_back(eval::register_external_method(m.name.substr(9), adapt::parse_rung(m.rung, ex.source, field + ".rung"),
+                                                          m.files, m.version));
+      } catch (const InputError& e) {
+        throw InputError(ex.source, field, e.what());
+      }
+    }
     eval::Plan plan = eval::make_plan(ex, resolver);
     if (o.policy_files && !ex.backbone.starts_with("external:"))
       throw InputError(o.experiment_file, "backbone", "--policy-files needs an external:<command> backbone (got \"" +

@@ -266,8 +266,8 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
       std::set<std::string> entry_keys;
       for (const auto& kv : m) {
         const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
-        if (key != "name" && key != "params")
-          throw InputError(at_line(source, kv.first), f + "." + key, "unknown key (expected name, params)");
+        if (key != "name" && key != "params" && key != "rung" && key != "version" && key != "files")
+          throw InputError(at_line(source, kv.first), f + "." + key, "unknown key (expected name, params; rung, version, files for external:<command>)");
         if (!entry_keys.insert(key).second) throw InputError(at_line(source, kv.first), f + "." + key, "duplicate key");
       }
       if (!m["name"]) throw InputError(at_line(source, m), f + ".name", "missing required key");
@@ -275,6 +275,18 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
       if (m["params"] && !m["params"].IsNull()) {
         if (!m["params"].IsMap()) throw InputError(at_line(source, m["params"]), f + ".params", "expected a mapping");
         entry.params = canonical_dump(to_json_value(m["params"], source, f + ".params"));
+      }
+      if ((m["rung"] || m["version"] || m["files"]) && !entry.name.starts_with("external:"))
+        throw InputError(at_line(source, m), f, "rung, version and files apply to an external:<command> method only");
+      if (m["rung"]) entry.rung = require_string(m["rung"], source, f + ".rung");
+      if (m["version"]) entry.version = require_string(m["version"], source, f + ".version");
+      if (m["files"]) {
+        if (!m["files"].IsSequence()) throw InputError(at_line(source, m["files"]), f + ".files", "expected a list of paths");
+        const auto dir = std::filesystem::path(source).parent_path();
+        for (std::size_t k = 0; k < m["files"].size(); ++k) {
+          const std::filesystem::path file = require_string(m["files"][k], source, f + ".files[" + std::to_string(k) + "]");
+          entry.files.push_back((file.is_absolute() ? file : dir / file).lexically_normal().string());
+        }
       }
     } else {
       throw InputError(at_line(source, m), f, "expected a method name or {name, params}");

@@ -82,6 +82,44 @@ PY
   run env PYTHONPATH="$PYMOD" "$AS" run "${common[@]}" --method "external:python3 $SERVER" --out "$TMP/ext2"
   [ "$RC" != 0 ] && ok || bad "a pool method declared rung none ran"
   expect_err "external method 'python3 $SERVER'" "the failing external method is named"
+  # an experiment names the external method with its rung and files; the plan's job carries them, so
+  # `run --plan --job-index` registers it from the job alone (as a Slurm array task does)
+  mkdir -p "$TMP/exp"
+  cp "$SERVER" "$SRC/docs/examples/separation_probes.py" "$TMP/exp/"
+  cat > "$TMP/exp/ext.yaml" <<YAML
+name: external_method
+tasks: [pick_cube]
+splits: [reference_seen]
+methods:
+  - name: "external:python3 $TMP/exp/separation_method_server.py"
+    rung: pool
+    version: "1"
+    files: [separation_method_server.py, separation_probes.py]
+  - entropy_probes
+seeds: [20260718]
+episodes: 9
+backbone: ppo
+pool: reference9
+YAML
+  run "$AS" plan --experiment "$TMP/exp/ext.yaml" --out "$TMP/plan"
+  expect_rc 0 "plan an experiment with an external method"
+  run env PYTHONPATH="$PYMOD" "$AS" run --plan "$TMP/plan/external_method.plan.json" --job-index 0 --out "$TMP/plan" --progress off
+  expect_rc 0 "run the plan's external-method job from its spec alone"
+  python3 - "$TMP/plan" "$TMP/ext" <<'PY' && ok || bad "the plan's external job repeats the external run's decisions"
+import glob, json, sys
+def outcomes(d):
+    out = []
+    for f in sorted(glob.glob(d + "/*.jsonl")):
+        for line in open(f):
+            r = json.loads(line)
+            if r["method"].startswith("external:"):
+                out.append((r["episode_index"], r["success_once"], r["probe_steps"], r["return"]))
+    return sorted(out)
+a, b = outcomes(sys.argv[1]), outcomes(sys.argv[2])
+assert len(a) == 9 and a == b, (a, b)
+spec = json.load(open(glob.glob(sys.argv[1] + "/*.plan.json")[0]))["jobs"][0]["spec"]
+assert spec["method"]["plugin"]["version"] == "1" and spec["method"]["plugin"]["rung"] == "pool"
+PY
 else
   echo "skipped: the external-method case needs the Python module"
 fi
@@ -150,6 +188,10 @@ expect_one_line_error "--method-rung with a built-in method"
 run "$AS" run "${common[@]}" --method 'external:python3 {x}.py' --out "$TMP/r"
 expect_rc 2 "an external method command with braces"
 expect_one_line_error "an external method command with braces"
+printf 'name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods:\n  - {name: no_adapt, rung: pool}\nseeds: [1]\nepisodes: 1\nbackbone: expert\n' > "$TMP/bad.yaml"
+run "$AS" plan --experiment "$TMP/bad.yaml" --out "$TMP/badplan"
+expect_rc 2 "rung on a built-in method in YAML"
+expect_err "rung, version and files apply to an external:<command> method only" "rung on a built-in method in YAML"
 run "$AS" report "$TMP/r" "$TMP/r" --out "$TMP/board3"
 expect_rc 2 "two directories without --leaderboard"
 expect_one_line_error "two directories without --leaderboard"

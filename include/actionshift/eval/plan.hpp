@@ -21,6 +21,11 @@ namespace actionshift::eval {
 struct MethodEntry {
   std::string name;             ///< method name, e.g. "oracle"
   std::string params{"{}"};     ///< canonical JSON object text of its parameters
+  /// An external method's (`external:<command>`, docs/methods.md) declared rung, version and files
+  /// (YAML keys rung, version, files; files relative to the experiment file's directory).
+  std::string rung{"none"};
+  std::string version{"0"};
+  std::vector<std::string> files;
   bool operator==(const MethodEntry&) const = default;
 };
 
