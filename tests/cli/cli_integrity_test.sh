@@ -24,9 +24,12 @@ cd "$TMP"
 # the repro: a valid generated split named like a built-in one (another seed, another hash)
 run "$AS" run --task pick_cube --split "my dir/seen.json" --method oracle --episodes 1 --threads 1 --out "$TMP/gs" --progress off
 expect_rc 0 "run --split FILE of a generated split"
-# validate wants a file named after its manifest; a job does not: any name and place
+# any name and place: validate notes a file name other than the manifest's (the name is a label) and passes
 cp "$TMP/my dir/seen.json" "$TMP/my dir/custom-split.json"
 mv "$TMP/my dir/full.json" "$TMP/my dir/custom pool.json"
+run "$AS" validate "$TMP/my dir/custom-split.json" "$TMP/my dir/custom pool.json"
+expect_rc 0 "validate a renamed split and pool"
+expect_out "the name is a label, the content hash the identity" "validate notes the file name"
 run "$AS" run --task pick_cube --split "my dir/custom-split.json" --method oracle --episodes 2 --threads 1 --out "$TMP/cs" --progress off
 expect_rc 0 "run --split FILE (relative, with a space, named like no built-in)"
 S=$(ls "$TMP"/cs/*.summary.json)
