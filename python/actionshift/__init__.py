@@ -359,31 +359,37 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
                              backbone_sha256)
 
 
+def _json_lines(fin):
+    """The JSON objects of a JSON-lines stream (blank lines skipped): the requests of the runner."""
+    for line in fin:
+        line = line.strip()
+        if line:
+            yield _json.loads(line)
+
+
+def _reply(fout, obj):
+    fout.write(_json.dumps(obj) + "\n")
+    fout.flush()
+
+
 def serve_policy(policy, stdin=None, stdout=None):
     """Serve ``policy`` (a callable, or a factory ``task -> callable`` if it has attribute
     ``from_task``) over the external-policy protocol (actionshift-policy-v1, docs/backbones.md) on
     stdin/stdout, so ``actionshift run --backbone "external:python3 my_policy.py"`` runs it."""
-    fin = stdin or _sys.stdin
     fout = stdout or _sys.stdout
     current = policy
-    for line in fin:
-        line = line.strip()
-        if not line:
-            continue
-        msg = _json.loads(line)
+    for msg in _json_lines(stdin or _sys.stdin):
         kind = msg.get("type")
         if kind == "hello":
             if hasattr(policy, "from_task"):
                 current = policy.from_task(msg["task"])
-            fout.write('{"type":"ready"}\n')
-            fout.flush()
+            _reply(fout, {"type": "ready"})
         elif kind == "reset":
             if hasattr(current, "reset"):
                 current.reset()
         elif kind == "step":
             action = _np.asarray(current(_np.asarray(msg["obs"], dtype=_np.float64)), dtype=_np.float64)
-            fout.write(_json.dumps({"action": [float(x) for x in action.reshape(-1)]}) + "\n")
-            fout.flush()
+            _reply(fout, {"action": [float(x) for x in action.reshape(-1)]})
 
 
 def serve_method(method, stdin=None, stdout=None):
@@ -392,14 +398,9 @@ def serve_method(method, stdin=None, stdout=None):
     docs/methods.md) on stdin/stdout, so ``actionshift run --method "external:python3 my_method.py"
     --method-rung RUNG`` runs it in its own process. ``setup(inputs)`` is called before each episode
     with the inputs of the hello (those of the rung the command line declared)."""
-    fin = stdin or _sys.stdin
     fout = stdout or _sys.stdout
     inputs = None
-    for line in fin:
-        line = line.strip()
-        if not line:
-            continue
-        msg = _json.loads(line)
+    for msg in _json_lines(stdin or _sys.stdin):
         kind = msg.get("type")
         if kind == "hello":
             given = msg.get("inputs") or {}
@@ -409,8 +410,7 @@ def serve_method(method, stdin=None, stdout=None):
                       "calibration": None if cal is None else ResponseModel(cal["alpha"], cal["sigma"], cal["gripper_alpha"],
                                                                              cal["gripper_sigma"]),
                       "grammar": given.get("grammar")}
-            fout.write('{"type":"ready"}\n')
-            fout.flush()
+            _reply(fout, {"type": "ready"})
         elif kind == "begin_episode":
             if hasattr(method, "setup"):
                 method.setup(inputs)
@@ -421,9 +421,7 @@ def serve_method(method, stdin=None, stdout=None):
             probe = False
             if isinstance(out, tuple):
                 out, probe = out
-            raw = [float(x) for x in _np.asarray(out, dtype=_np.float64).reshape(-1)]
-            fout.write(_json.dumps({"raw": raw, "probe": bool(probe)}) + "\n")
-            fout.flush()
+            _reply(fout, {"raw": [float(x) for x in _np.asarray(out, dtype=_np.float64).reshape(-1)], "probe": bool(probe)})
         elif kind == "observe":
             if hasattr(method, "observe_fingers") and msg.get("finger_delta") is not None:
                 method.observe_fingers(msg["finger_delta"])
