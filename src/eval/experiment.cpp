@@ -82,7 +82,10 @@ adapt::ResponseCalibration builtin_selftest_calibration(const std::string& task,
 
 MethodEntry canonical_method(const MethodEntry& m) {
   const adapt::MethodLabel label = adapt::parse_method_label(m.name);
-  return MethodEntry{label.name, canonical_dump(adapt::merge_method_params(label, parse_params(m.params, label.name)))};
+  MethodEntry out = m;  // an external method keeps its rung, version and files
+  out.name = label.name;
+  out.params = canonical_dump(adapt::merge_method_params(label, parse_params(m.params, label.name)));
+  return out;
 }
 
 std::string resolved_method_params(const std::string& method, const std::string& params_json) {

@@ -13,12 +13,17 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace actionshift::eval {
 
 /// A method of an experiment with its parameters.
 struct MethodEntry {
+  MethodEntry() = default;
+  /// A method and its parameters (an external method's rung, version and files keep their defaults).
+  MethodEntry(std::string method_name, std::string method_params = "{}")
+      : name(std::move(method_name)), params(std::move(method_params)) {}
   std::string name;             ///< method name, e.g. "oracle"
   std::string params{"{}"};     ///< canonical JSON object text of its parameters
   /// An external method's (`external:<command>`, docs/methods.md) declared rung, version and files
