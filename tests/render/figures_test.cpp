@@ -122,7 +122,7 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
   fs::create_directories(root / "results");
   const auto recs = concat({cell("pick_cube", "seen", "oracle", 8, 8, 0), cell("pick_cube", "seen", "no_adapt", 8, 0, 0)});
   {
-    // the summary below is a stub, not the oracle job's real one: its records are in a file of another name,
+    // the summary below is written by hand for this test, not the oracle job's own: its records are in a file of another name,
     // so that load_results does not check them against it (records_sha256)
     std::ofstream f(root / "results" / "oracle-records.jsonl");
     for (const auto& r : recs)
