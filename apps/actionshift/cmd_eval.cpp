@@ -14,6 +14,7 @@
 #include "actionshift/adapt/plugin.hpp"
 #include "actionshift/eval/external_method.hpp"
 #include "actionshift/policy/external.hpp"
+#include "actionshift/policy/line_process.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -488,9 +489,31 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
   });
 }
 
+namespace {
+// External policies and methods cannot see the results directory (other episodes' seeds and
+// contracts), the plan and the seed file (the job's seed), nor the runner's /proc entries. The
+// directory is made now, so that it exists to be hidden when the first process starts.
+void configure_external_sandbox(const RunPlanOptions& o) {
+  policy::SandboxConfig config;
+  try {
+    config.mode = policy::parse_sandbox_mode(o.sandbox);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("command line", "--sandbox", e.what());
+  }
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec) throw InputError(o.out_dir, "--out", "cannot create directory: " + ec.message());
+  config.hidden_paths = o.hidden_paths;
+  config.hidden_paths.push_back(o.out_dir);
+  if (!o.plan_file.empty()) config.hidden_paths.push_back(o.plan_file);
+  policy::configure_sandbox(std::move(config));
+}
+}  // namespace
+
 int run_plan_jobs(const RunPlanOptions& o, const EpisodeFnFactory& make, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {
     check_output_dir(o.out_dir, "--out");
+    configure_external_sandbox(o);
     const eval::Plan plan = eval::load_plan(o.plan_file);
     // a failing job is named by its plan entry (announce's line is not printed with --progress off)
     const auto run_entry = [&](const eval::PlannedJob& pj) {
@@ -527,6 +550,7 @@ int run_one_job(const eval::JobSpec& job, const RunPlanOptions& o, const Episode
                 std::ostream& err) {
   return guarded(err, [&] {
     check_output_dir(o.out_dir, "--out");
+    configure_external_sandbox(o);
     run_with(job, o, make, out, err);
     return kOk;
   });

@@ -100,6 +100,8 @@ struct RunPlanOptions {
   bool fsync{false};                        // --fsync
   std::string progress{"auto"};             // --progress auto|bar|lines|off
   double step_timeout_s{10.0};              // --step-timeout S: external policy request/reply bound
+  std::string sandbox{"auto"};              // --sandbox auto|on|off: external processes' sandbox
+  std::vector<std::string> hidden_paths;    // hidden from them besides --out and --plan (the seed file)
 };
 int run_plan_jobs(const RunPlanOptions& options, const EpisodeFnFactory& make_episode_fn,
                   std::ostream& out = std::cout, std::ostream& err = std::cerr);

@@ -112,6 +112,8 @@ void resolve_cli_job(const CliJobOptions& o, eval::JobSpec& job, eval::EpisodeFn
 
 int run_run(const RunCliOptions& o) {
   eval::EpisodeFnOptions options;
+  RunPlanOptions run = o.run;
+  if (!o.job.seed_file.empty()) run.hidden_paths.push_back(o.job.seed_file);
   options.external.step_timeout_s = o.run.step_timeout_s;
   if (!o.run.plan_file.empty()) {
     const EpisodeFnFactory factory = [options](const eval::JobSpec& job) {
@@ -126,13 +128,13 @@ int run_run(const RunCliOptions& o) {
                    " --calibration and --obs-noise apply to a single job only\n";
       return kBadInput;
     }
-    return run_plan_jobs(o.run, factory);
+    return run_plan_jobs(run, factory);
   }
   try {
     eval::JobSpec job;
     resolve_cli_job(o.job, job, options);
     const EpisodeFnFactory factory = [options](const eval::JobSpec& j) { return eval::make_episode_fn(j, options); };
-    return run_one_job(job, o.run, factory);
+    return run_one_job(job, run, factory);
   } catch (const eval::Interrupted&) {
     throw;  // not an error: main says where the job stopped (exit 130)
   } catch (const std::exception& e) {

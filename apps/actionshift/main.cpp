@@ -540,6 +540,12 @@ int main(int argc, char** argv) {
                   "(a process that overruns, floods replies or dies ends the job with an error)")
       ->check(CLI::Range(0.001, 86400.0) & kNotNan)
       ->capture_default_str();
+  run->add_option("--sandbox", run_o.run.sandbox,
+                  "auto, on or off: external:<command> backbones and methods run in new user, mount and PID\n"
+                  "namespaces where they see no process of the runner's and find --out, --plan and --seed-file\n"
+                  "empty (auto: when this machine allows it, else with a warning; on: or fail)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
   run->callback([&] {
     action = [&] {
       if (job_index->count() > 0 && run_o.run.plan_file.empty()) {  // was ignored: the single job ran

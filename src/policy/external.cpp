@@ -1,6 +1,7 @@
 // external-process policy: JSON lines over a child's stdin/stdout with timeouts
 #include "actionshift/policy/external.hpp"
 #include "actionshift/policy/line_process.hpp"
+#include "sandbox.hpp"
 
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -225,6 +226,7 @@ LineProcess::LineProcess(std::string command, std::string role)
       "wait $!\n";
   char* argv[] = {sh.data(), dash_c.data(), wrapper.data(), name.data(), command_.data(), nullptr};
   const pid_t parent = getpid();
+  const detail::SandboxPlan sandbox = detail::sandbox_plan_for(role_ + " '" + command_ + "'");
   int rc = 0;
   Spawner::instance().run([&] {
     const pid_t pid = fork();
@@ -241,6 +243,10 @@ LineProcess::LineProcess(std::string command, std::string role)
       const int in = fcntl(in_pipe[0], F_DUPFD_CLOEXEC, 3);
       const int out = fcntl(out_pipe[1], F_DUPFD_CLOEXEC, 3);
       if (in < 0 || out < 0 || dup2(in, STDIN_FILENO) < 0 || dup2(out, STDOUT_FILENO) < 0) _exit(127);
+      // no descriptor of the runner's but stdin, stdout and stderr (a results file opened without
+      // O_CLOEXEC would otherwise be readable through /proc/self/fd)
+      close_range(3, ~0U, 0);
+      detail::enter_sandbox_in_child(sandbox);
       sigset_t none;
       sigemptyset(&none);
       sigprocmask(SIG_SETMASK, &none, nullptr);  // the spawner thread blocks every signal

@@ -124,58 +124,118 @@ else
   echo "skipped: the external-method case needs the Python module"
 fi
 
-# a hostile external method (rung none) logs everything it can reach: the protocol's messages, its
-# environment and the command lines of its ancestors up to the runner. None of it names a contract of
-# the split or the job's seed (given by --seed-file, so it is not on the runner's command line either)
+# a hostile external method (rung none) logs everything it can reach, at its start and at every
+# episode: the protocol's messages, its environment, the command line and environment of every
+# process it can see in /proc, the targets of its open descriptors, and the results directory and
+# seed file (whose paths a method could guess; the test hands them over). Sandboxed (the default
+# where the machine allows it), none of it names a contract of the split, a contract hash of the
+# records or the job's seed (given by --seed-file, so it is not on the runner's command line either).
+# With --sandbox off the same method finds the seed and the records: the routes are real.
 cat > "$TMP/hostile.py" <<'PY'
 import json, os, sys
 log = open(os.environ["HOSTILE_LOG"], "w")
-def ancestors():
-    pid, out = os.getpid(), []
-    for _ in range(6):
+peek = os.environ["HOSTILE_PEEK"].split(":")
+def read(path):
+    try:
+        return open(path, "rb").read().decode(errors="replace")
+    except OSError:
+        return None
+def snoop():
+    found = {"environ": dict(os.environ), "argv": sys.argv, "procs": {}, "fds": {}, "files": {}}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        for what in ("cmdline", "environ"):
+            text = read(f"/proc/{pid}/{what}")
+            if text is not None:
+                found["procs"][f"{pid}/{what}"] = text
+    for fd in os.listdir("/proc/self/fd"):
         try:
-            out.append(open(f"/proc/{pid}/cmdline", "rb").read().decode(errors="replace"))
-            pid = int(open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[1])
+            found["fds"][fd] = os.readlink(f"/proc/self/fd/{fd}")
         except OSError:
-            break
-    return out
-log.write(json.dumps({"environ": dict(os.environ), "cmdlines": ancestors(), "argv": sys.argv}) + "\n")
+            pass
+    for p in peek:
+        for root, _, files in os.walk(p):
+            for f in files:
+                found["files"][os.path.join(root, f)] = read(os.path.join(root, f))
+        if os.path.isfile(p):
+            found["files"][p] = read(p)
+    log.write(json.dumps({"snoop": found}) + "\n")
+    log.flush()
+snoop()
 for line in sys.stdin:
     log.write(line)
     msg = json.loads(line)
     if msg["type"] == "hello":
         print('{"type":"ready"}', flush=True)
+    elif msg["type"] == "begin_episode":
+        snoop()
     elif msg["type"] == "encode":
         print(json.dumps({"raw": msg["canonical"], "probe": False}), flush=True)
 PY
 echo 987654321987 > "$TMP/seed"
-run env HOSTILE_LOG="$TMP/hostile.log" "$AS" run --task pick_cube --split reference_seen --backbone expert --episodes 9 \
-  --threads 1 --progress off --seed-file "$TMP/seed" --method "external:python3 $TMP/hostile.py" --out "$TMP/hostile"
-expect_rc 0 "the hostile external method runs"
-python3 - "$TMP/hostile.log" "$SRC/manifests/reference_seen.json" <<'PY' && ok || bad "a hostile external method reached the contract or the seed"
-import json, sys
+sandbox_possible=1
+unshare -Urmpf --mount-proc true 2>/dev/null || sandbox_possible=0
+run_hostile() {  # run_hostile OUT_NAME [run options...]
+  local name=$1
+  shift
+  run env HOSTILE_LOG="$TMP/$name.log" HOSTILE_PEEK="$TMP/$name:$TMP/seed" "$AS" run --task pick_cube --split reference_seen \
+    --backbone expert --episodes 9 --threads 1 --progress off --seed-file "$TMP/seed" \
+    --method "external:python3 $TMP/hostile.py" --out "$TMP/$name" "$@"
+}
+if [ "$sandbox_possible" = 1 ]; then
+  run_hostile hostile --sandbox on
+  expect_rc 0 "the hostile external method runs in the sandbox"
+  python3 - "$TMP/hostile.log" "$SRC/manifests/reference_seen.json" "$TMP/hostile" <<'PY' && ok || bad "a sandboxed hostile external method reached the contract, the seed or the records"
+import glob, json, sys
 text = open(sys.argv[1]).read()
 split = json.load(open(sys.argv[2]))
 secrets = {"987654321987"}
 for c in split["test"]:
     secrets.add(json.dumps(c, sort_keys=True, separators=(",", ":")))
+hashes = {json.loads(l)["contract_sha256"] for f in glob.glob(sys.argv[3] + "/*.jsonl") for l in open(f)}
+assert len(hashes) >= 2
+secrets |= hashes
 leaks = [s for s in secrets if s in text]
 assert not leaks, leaks
 lines = [json.loads(l) for l in text.splitlines()]
+snoops = [l["snoop"] for l in lines if "snoop" in l]
+assert len(snoops) == 10, len(snoops)  # at its start and at each of the 9 episodes
+for s in snoops:
+    assert all(v in ("", None) for v in s["files"].values()), s["files"]  # the results and seed file: empty
+    # no runner in sight: only the sandbox's own processes (its leader, sh -c and python)
+    assert not any("--seed-file" in v or "--out" in v for v in s["procs"].values()), s["procs"]
+    assert len({k.split("/")[0] for k in s["procs"]}) <= 3, sorted(s["procs"])
+    assert set(s["fds"]) <= {"0", "1", "2", "3", "4"}, s["fds"]  # stdio, the log, the listing itself
 hello = next(l for l in lines if l.get("type") == "hello")
 assert hello["rung"] == "none" and hello["inputs"] == {"pool": None, "calibration": None, "grammar": None}, hello
 assert set(hello) == {"type", "protocol", "task", "rung", "params", "inputs"}, set(hello)
-keys = {k for l in lines[1:] for k in l}
+keys = {k for l in lines if "snoop" not in l for k in l}
 assert keys <= {"type", "seed", "canonical", "R", "raw", "response", "finger_delta", "protocol", "task", "rung", "params", "inputs"}, keys
 assert not any("contract" in k for k in keys)
 PY
-# contract hashes of the split appear nowhere either (the records name them; the method never sees them)
-python3 - "$TMP/hostile.log" "$TMP/hostile" <<'PY' && ok || bad "a contract hash reached the hostile method"
+  # the same method without the sandbox reads the seed file, other episodes' records and the runner's
+  # command line: what the sandbox closes
+  run_hostile open --sandbox off
+  expect_rc 0 "the hostile external method runs without the sandbox"
+  python3 - "$TMP/open.log" "$TMP/open" <<'PY' && ok || bad "without the sandbox the hostile method should see the seed and the records (the test would prove nothing)"
 import glob, json, sys
 text = open(sys.argv[1]).read()
 hashes = {json.loads(l)["contract_sha256"] for f in glob.glob(sys.argv[2] + "/*.jsonl") for l in open(f)}
-assert len(hashes) >= 2 and not any(h in text for h in hashes)
+assert "987654321987" in text
+assert any(h in text for h in hashes)
+snoops = [json.loads(l)["snoop"] for l in text.splitlines() if l.startswith('{"snoop"')]
+assert any("actionshift" in v and "--seed-file" in v for s in snoops for v in s["procs"].values())
 PY
+  # the default (auto) is the sandbox where the machine allows it: no warning, the same closure
+  run_hostile auto
+  expect_rc 0 "the hostile external method runs with --sandbox auto"
+  expect_no_err "without a sandbox" "auto uses the sandbox here"
+  python3 -c "import sys; t=open(sys.argv[1]).read(); assert '987654321987' not in t" "$TMP/auto.log" && ok || bad "auto left the seed file readable"
+else
+  echo "SKIPPED: this machine makes no user/mount/PID namespaces (unshare -Urmpf failed): the sandbox cases did not run"
+  run_hostile hostile --sandbox on
+  expect_rc 2 "--sandbox on where no sandbox can be made"
+  expect_one_line_error "--sandbox on where no sandbox can be made"
+fi
 
 # bad input: one line, exit 2
 run "$AS" report "$TMP/r" --leaderboard --reference no_such_method --out "$TMP/board2"

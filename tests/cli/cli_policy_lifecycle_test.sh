@@ -2,8 +2,9 @@
 # The lifecycle of an external policy's processes around `actionshift run`: SIGTERM reaches a policy
 # that blocks in a step at once (not after --step-timeout), a second SIGTERM or a SIGKILL of the
 # runner does not leave the policy's process group running, and a child that the policy moved to its own session
-# (setsid) does not outlive a normal run. Every check has a bound, so a regression fails instead of
-# hanging; every process the policy starts is killed at the end whatever happens.
+# (setsid) does not outlive a normal run. These cases run unsandboxed (--sandbox off: they read the
+# policy's pids, which a sandbox's PID namespace would renumber); the last runs sandboxed. Every check
+# has a bound, so a regression fails instead of hanging; every process the policy starts is killed at the end whatever happens.
 set -euo pipefail
 AS="$1"
 SRC="$2"
@@ -17,11 +18,13 @@ import json, os, subprocess, sys, time
 state = sys.argv[1]
 with open(f"{state}/policy.pid", "w") as f:
     f.write(f"{os.getpid()} {os.getpgrp()}\n")
-member = subprocess.Popen(["sleep", "1000"])
+# a sandboxed run's pids are its PID namespace's: such a run names its sleeps by a unique duration instead
+tag = open(f"{state}/tag").read().strip() if os.path.exists(f"{state}/tag") else "1000"
+member = subprocess.Popen(["sleep", tag])
 with open(f"{state}/member.pid", "w") as f:
     f.write(f"{member.pid}\n")
 if os.path.exists(f"{state}/setsid"):
-    escaped = subprocess.Popen(["setsid", "sleep", "1000"])
+    escaped = subprocess.Popen(["setsid", "sleep", tag])
     with open(f"{state}/escaped.pid", "w") as f:
         f.write(f"{escaped.pid}\n")
 block_after = None
@@ -72,7 +75,7 @@ start_run() {
   STATES+=("$st")
   "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes "$2" --threads 1 \
     --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_$1" --progress off \
-    >"$st/run.out" 2>"$st/run.err" &
+    --sandbox "${SANDBOX:-off}" >"$st/run.out" 2>"$st/run.err" &
   RUN_PID=$!
 }
 # the policy command names $TMP/state (one job id for all runs): point it at this run's state
@@ -121,7 +124,8 @@ if wait_for "$TMP/term/blocked" 120; then
   # resume with a policy that answers: the first records are untouched, the job completes
   rm -f "$TMP/term/block" "$TMP/term/blocked"
   run timeout 300 "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 6 --threads 1 \
-    --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_term" --progress off
+    --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_term" --progress off \
+    --sandbox off
   expect_rc 0 "resume after SIGTERM"
   # the policy's `sleep` died with its group: it is no leftover
   ! grep -qF "left behind" <<<"$ERR" && ok || bad "resume after SIGTERM: a member of the policy's group counted as a leftover: $ERR"
@@ -192,7 +196,8 @@ mkdir -p "$TMP/escape"
 touch "$TMP/escape/setsid"
 use_state escape
 run timeout 300 "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 1 --threads 1 \
-  --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_escape" --progress off
+  --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_escape" --progress off \
+  --sandbox off
 expect_rc 0 "a policy with a setsid child"
 if [ -f "$TMP/escape/escaped.pid" ]; then
   esc=$(cat "$TMP/escape/escaped.pid")
@@ -204,5 +209,43 @@ else
   bad "the policy did not start its setsid child"
 fi
 cleanup_state "$TMP/escape"
+
+# ---- sandboxed (--sandbox on): a SIGKILL of the runner ends the whole PID namespace, the policy, its
+# group's `sleep` and its setsid child with it. Inside the namespace pids mean nothing out here, so the
+# processes are found by the unique duration of their sleeps and the policy's unique path.
+if unshare -Urmpf --mount-proc true 2>/dev/null; then
+  tag="1000.$RANDOM$RANDOM"
+  mkdir -p "$TMP/boxed"
+  echo 0 > "$TMP/boxed/block"
+  echo "$tag" > "$TMP/boxed/tag"
+  touch "$TMP/boxed/setsid"
+  trap 'pkill -KILL -f "sleep $tag" 2>/dev/null || true; for d in "${STATES[@]}"; do cleanup_state "$d"; done; rm -rf "$TMP"' EXIT
+  use_state boxed
+  mkdir -p "$TMP/boxed_run"
+  st="$TMP/boxed_run"
+  "$AS" run --task pick_cube --split reference_seen --method no_adapt --episodes 2 --threads 1 \
+    --backbone "external:python3 $TMP/policy.py $TMP/state" --step-timeout 30 --out "$TMP/out_boxed" --progress off \
+    --sandbox on >"$st/run.out" 2>"$st/run.err" &
+  RUN_PID=$!
+  if wait_for "$TMP/boxed/blocked" 120; then
+    pgrep -f "sleep $tag" >/dev/null && ok || bad "sandboxed: the policy's sleeps are not visible from outside"
+    [ "$(pgrep -fc "sleep $tag")" = 2 ] && ok || bad "sandboxed: expected the policy's two sleeps"
+    t0=$(now_ms)
+    kill -KILL "$RUN_PID"
+    wait_exit "$RUN_PID" 10
+    gone=0
+    for _ in $(seq 1 100); do
+      if ! pgrep -f "sleep $tag" >/dev/null && ! pgrep -f "$TMP/policy.py" >/dev/null; then gone=1; break; fi
+      sleep 0.05
+    done
+    echo "sandboxed: SIGKILL of the runner to every policy process gone (setsid child included): $(($(now_ms) - t0)) ms"
+    [ "$gone" = 1 ] && ok || bad "sandboxed: SIGKILL of the runner left the policy or its sleeps running"
+  else
+    bad "sandboxed: the policy never blocked ($(cat "$st/run.err"))"
+  fi
+  pkill -KILL -f "sleep $tag" 2>/dev/null || true
+else
+  echo "SKIPPED: this machine makes no user/mount/PID namespaces: the sandboxed case did not run"
+fi
 
 finish

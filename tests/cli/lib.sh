@@ -19,6 +19,7 @@ run() {
 expect_rc() { [ "$RC" = "$1" ] && ok || bad "$2: exit $RC, expected $1 (stderr: $ERR)"; }
 expect_out() { grep -qF -- "$1" <<<"$OUT" && ok || bad "$2: stdout lacks '$1'"; }
 expect_err() { grep -qF -- "$1" <<<"$ERR" && ok || bad "$2: stderr lacks '$1' (got: $ERR)"; }
+expect_no_err() { if grep -qF -- "$1" <<<"$ERR"; then bad "$2: stderr has '$1' (got: $ERR)"; else ok; fi; }
 expect_one_line_error() {
   local n
   n=$(printf '%s' "$ERR" | grep -c '' || true)

@@ -165,3 +165,48 @@ def test_method_errors_are_one_line(tmp_path):
 
     with pytest.raises(ValueError, match="NaN"):
         actionshift.evaluate("expert", method=NaN("none"), episodes=1, out=str(tmp_path / "nan"))
+
+
+class Snoop:
+    """A hostile method (pool rung, the most privileged a user method can declare): keeps everything the
+    runner hands it, its process's environment and arguments, and any attribute the runner sets on it."""
+    name, version, rung, params = "snoop", "1", "pool", {}
+
+    def __init__(self):
+        self.log = []
+
+    def setup(self, inputs):
+        self.log.append(("setup", repr(inputs)))
+
+    def begin_episode(self, seed):
+        self.log.append(("begin_episode", seed, json.dumps(dict(os.environ)), json.dumps(sys.argv),
+                         sorted(k for k in vars(self) if k != "log")))
+
+    def encode(self, canonical, R):
+        self.log.append(("encode", repr(np.asarray(canonical)), repr(np.asarray(R))))
+        return canonical
+
+    def observe(self, raw, response, R):
+        self.log.append(("observe", repr(np.asarray(raw)), repr(response)))
+
+
+def test_a_hostile_python_method_learns_neither_contract_nor_seed(tmp_path):
+    snoop = Snoop()
+    secret_seed = 987654321987
+    r = actionshift.evaluate("expert", split="reference_seen", pool="reference9", method=snoop, episodes=9,
+                             seed=secret_seed, out=str(tmp_path))
+    recs = records(r["jsonl_path"])
+    text = json.dumps(snoop.log, default=str)
+    split = json.load(open(os.path.join(HERE, "..", "..", "manifests", "reference_seen.json")))
+    secrets = {str(secret_seed)} | {rec["contract_sha256"] for rec in recs}
+    secrets |= {json.dumps(c, sort_keys=True, separators=(",", ":")) for c in split["test"]}
+    assert len({rec["contract_sha256"] for rec in recs}) >= 2
+    assert not [s for s in secrets if s in text]
+    begins = [e for e in snoop.log if e[0] == "begin_episode"]
+    assert len(begins) == 9
+    assert all(e[4] == [] for e in begins)  # the runner sets no attribute on the method
+    # its seed is the block's, the same whichever contract is hidden: the 9 contracts of one block
+    by_block = {}
+    for e, rec in zip(begins, sorted(recs, key=lambda x: x["episode_index"])):
+        by_block.setdefault(rec["episode_index"] // len(split["test"]), set()).add(e[1])
+    assert all(len(seeds) == 1 for seeds in by_block.values()), by_block

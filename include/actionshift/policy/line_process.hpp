@@ -9,8 +9,35 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace actionshift::policy {
+
+/// Whether external processes (policies and methods) run in a sandbox: kAuto, in one when this
+/// machine allows it, else without and with one warning on stderr; kOn, in one or not at all (the
+/// start fails naming the reason); kOff, never.
+enum class SandboxMode { kAuto, kOn, kOff };
+/// "auto" | "on" | "off"; throws std::invalid_argument otherwise.
+SandboxMode parse_sandbox_mode(std::string_view text);
+
+/// The sandbox: the command runs in new user, mount and PID namespaces (as the same user), so it
+/// sees no process outside its own (no /proc entry of the runner: its command line, environment,
+/// open files, working directory or memory), each path of `hidden_paths` as an empty read-only
+/// directory or empty file (the results directory, the seed file, the plan), and it inherits no file
+/// descriptor but stdin, stdout and stderr (that last also without a sandbox). Paths that do not
+/// exist when a process starts are not hidden: create them first. It is not a security boundary
+/// against a process that can gain privileges; it closes the routes to a job's secrets that a user
+/// method or policy could otherwise take as the same user.
+struct SandboxConfig {
+  SandboxMode mode{SandboxMode::kOff};
+  std::vector<std::string> hidden_paths;
+};
+/// Process-wide: applies to the processes started after the call. Off until configured: the library
+/// starts processes as it always did; `actionshift run` configures auto per job.
+void configure_sandbox(SandboxConfig config);
+/// Empty if this machine can make the sandbox, else why not (probed once, by starting a process).
+const std::string& sandbox_unavailable_reason();
 
 /// True while a live LineProcess leads process group `pgid` (an external policy or method still in
 /// use: not a process left behind).
