@@ -31,7 +31,7 @@ int run_compare(const CompareOptions& o) {
         o.paper_file.empty() ? eval::builtin_paper_numbers()
                              : eval::parse_paper_numbers(read_input_file(o.paper_file, "a paper-numbers file", std::uintmax_t{64} << 20),
                                                          o.paper_file);
-    const nlohmann::json j = eval::compare_directories(o.results_dirs, pairs, paper, o.common_episodes);
+    const nlohmann::json j = eval::compare_directories(o.results_dirs, pairs, paper, o.common_episodes, o.across_backbones);
     for (const auto& d : j["inputs"]["results_dirs"])
       for (const auto& note : d["notes"]) std::cerr << "actionshift: note: " << note.get<std::string>() << "\n";
     if (o.out_file.empty()) {

@@ -73,6 +73,7 @@ struct CompareOptions {
   std::string paper_file;                 ///< --paper FILE ("" → the built-in configs/paper/numbers.json)
   std::string out_file;                   ///< --out FILE ("" → stdout)
   bool common_episodes = false;           ///< --common-episodes: pair the episodes both cells hold
+  bool across_backbones = false;          ///< --across-backbones: each pair per backbone and pooled over backbones
 };
 int run_compare(const CompareOptions& o);
 

@@ -654,6 +654,12 @@ int main(int argc, char** argv) {
                     "Pair only the episodes both cells of a pair hold (a 50-episode job with the first 50 of a\n"
                     "200-episode one) instead of refusing cells whose episode sets differ; each comparison says in\n"
                     "'unpaired' how many it left out. Check those counts: an unfinished job is left out silently otherwise");
+  compare->add_flag("--across-backbones", cmp_o.across_backbones,
+                    "Backbone as a random effect: for each same-backbone pair and each (task, split) that two or\n"
+                    "more backbones hold, add to 'across_backbones' the difference per backbone (cluster bootstrap\n"
+                    "over seed and block, a block being the episodes that share an initial state), pooled over the\n"
+                    "backbones (hierarchical bootstrap: backbones, then seeds, then blocks) and a verdict:\n"
+                    "holds_on_every_backbone, holds_on_average, depends_on_backbone or not_shown");
   compare->callback([&] { action = [&] { return cli::run_compare(cmp_o); }; });
 
   cli::CalibrateOptions cal_o;

@@ -556,8 +556,95 @@ const PaperNumber* find_paper_difference(const PaperNumbers& paper, std::string_
   return p;
 }
 
+namespace {
+// ---- backbone as a random effect
+
+// the paired differences of one backbone's two cells, by seed and block (episodes sharing an initial state)
+std::vector<std::vector<std::vector<double>>> clustered_differences(const std::vector<EpisodeRecord>& cand,
+                                                                    const std::vector<EpisodeRecord>& base) {
+  std::map<PairKey, const EpisodeRecord*> b;
+  for (const auto& r : base) b.emplace(PairKey{r.seed, r.contract_index, r.episode_index}, &r);
+  std::set<std::int64_t> contracts;
+  for (const auto& r : cand) contracts.insert(r.contract_index);
+  const auto n = static_cast<std::int64_t>(contracts.size());
+  std::map<std::uint64_t, std::map<std::int64_t, std::vector<double>>> by_seed;  // seed → block → differences
+  for (const auto& r : cand) {
+    const auto it = b.find(PairKey{r.seed, r.contract_index, r.episode_index});
+    if (it == b.end()) continue;  // an unpaired episode (--common-episodes; otherwise the pair was refused)
+    by_seed[r.seed][r.episode_index / n].push_back(static_cast<double>(static_cast<int>(r.success_once) -
+                                                                       static_cast<int>(it->second->success_once)));
+  }
+  std::vector<std::vector<std::vector<double>>> out;
+  for (auto& [seed, blocks] : by_seed) {
+    out.emplace_back();
+    for (auto& [block, d] : blocks) out.back().push_back(std::move(d));
+  }
+  return out;
+}
+
+int direction(const BootstrapInterval& d) { return d.lower > 0.0 ? 1 : d.upper < 0.0 ? -1 : 0; }
+const char* direction_name(int d) { return d > 0 ? "positive" : d < 0 ? "negative" : "none"; }
+
+json interval_json(const BootstrapInterval& d) {
+  return {{"estimate", d.estimate}, {"lower", d.lower},     {"upper", d.upper},
+          {"confidence", d.confidence}, {"samples", d.samples}, {"seed", d.seed},
+          {"pairs", d.pairs}, {"direction", direction_name(direction(d))}};
+}
+
+json across_backbones_json(const ComparisonPair& pair, const std::string& task, const std::string& split,
+                           const std::vector<std::pair<std::string, std::pair<const std::vector<EpisodeRecord>*,
+                                                                              const std::vector<EpisodeRecord>*>>>& cells) {
+  ClusteredValues all;
+  json per = json::array();
+  std::vector<int> dirs;
+  std::vector<std::string> names;
+  for (const auto& [backbone, two] : cells) {
+    auto clustered = clustered_differences(*two.first, *two.second);
+    if (clustered.empty()) throw InputError("results", task + "/" + split + "/" + backbone, "the two cells hold no episode in common");
+    const BootstrapInterval d = hierarchical_bootstrap({clustered}, 0.95, kBootstrapSamples, kBootstrapSeed);
+    per.push_back({{"backbone", backbone}, {"seeds", clustered.size()}, {"difference", interval_json(d)}});
+    dirs.push_back(direction(d));
+    names.push_back(backbone);
+    all.push_back(std::move(clustered));
+  }
+  const BootstrapInterval pooled = hierarchical_bootstrap(all, 0.95, kBootstrapSamples, kBootstrapSeed);
+  const int pd = direction(pooled);
+  const bool any_pos = std::count(dirs.begin(), dirs.end(), 1) > 0, any_neg = std::count(dirs.begin(), dirs.end(), -1) > 0;
+  std::string verdict, reason;
+  const auto list = [&](auto pred) {
+    std::string t;
+    for (std::size_t i = 0; i < dirs.size(); ++i)
+      if (pred(dirs[i])) t += (t.empty() ? "" : ", ") + names[i];
+    return t;
+  };
+  if (any_pos && any_neg) {
+    verdict = "depends_on_backbone";
+    reason = "positive on " + list([](int d) { return d > 0; }) + ", negative on " + list([](int d) { return d < 0; });
+  } else if (pd != 0 && std::all_of(dirs.begin(), dirs.end(), [&](int d) { return d == pd; })) {
+    verdict = "holds_on_every_backbone";
+    reason = std::string("the pooled interval and each of the ") + std::to_string(dirs.size()) + " backbones' exclude 0 (" +
+             direction_name(pd) + ")";
+  } else if (pd != 0) {
+    verdict = "holds_on_average";
+    reason = std::string("the pooled interval excludes 0 (") + direction_name(pd) + "); not shown on " +
+             list([](int d) { return d == 0; });
+  } else if (any_pos || any_neg) {
+    verdict = "depends_on_backbone";
+    reason = "the pooled interval includes 0; shown (" + std::string(direction_name(any_pos ? 1 : -1)) + ") on " +
+             list([](int d) { return d != 0; }) + " only";
+  } else {
+    verdict = "not_shown";
+    reason = "no backbone's interval and not the pooled one excludes 0";
+  }
+  return {{"candidate", pair.candidate}, {"baseline", pair.baseline}, {"task", task}, {"split", split},
+          {"backbones", per},           {"pooled", interval_json(pooled)},
+          {"verdict", verdict},         {"verdict_reason", reason}};
+}
+
+}  // namespace
+
 json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
-                     const PaperNumbers& paper, const CompareInputs& inputs, bool common_episodes) {
+                     const PaperNumbers& paper, const CompareInputs& inputs, bool common_episodes, bool across_backbones) {
   {
     std::set<std::string> seen;
     for (const auto& p : pairs)
@@ -641,11 +728,28 @@ json compare_records(const std::vector<EpisodeRecord>& records, const std::vecto
                             {"cells_compared", compared},
                             {"cells_with_one_side", one_sided}});
   }
+  if (across_backbones) {
+    out["across_backbones"] = json::array();
+    for (const auto& pair : pairs) {
+      if (pair.cross_backbone()) continue;
+      std::map<std::pair<std::string, std::string>,
+               std::vector<std::pair<std::string, std::pair<const std::vector<EpisodeRecord>*, const std::vector<EpisodeRecord>*>>>>
+          by_task_split;
+      for (const auto& [g, by_label] : groups) {
+        const auto ci = by_label.find(pair.candidate), bi = by_label.find(pair.baseline);
+        if (ci == by_label.end() || bi == by_label.end()) continue;
+        const auto& [task, split, backbone] = g;
+        by_task_split[{task, split}].push_back({backbone, {&by_cell.at(ci->second), &by_cell.at(bi->second)}});
+      }
+      for (const auto& [ts, cells_of] : by_task_split)
+        if (cells_of.size() >= 2) out["across_backbones"].push_back(across_backbones_json(pair, ts.first, ts.second, cells_of));
+    }
+  }
   return out;
 }
 
 json compare_directories(const std::vector<std::string>& dirs, const std::vector<ComparisonPair>& pairs,
-                         const PaperNumbers& paper, bool common_episodes) {
+                         const PaperNumbers& paper, bool common_episodes, bool across_backbones) {
   namespace fs = std::filesystem;
   if (dirs.empty()) throw InputError("compare", "RESULTS_DIR", "give at least one results directory");
   CompareInputs inputs;
@@ -663,7 +767,7 @@ json compare_directories(const std::vector<std::string>& dirs, const std::vector
     inputs.directories.push_back({d, rs.files, rs.records.size(), rs.notes});
     records.insert(records.end(), std::make_move_iterator(rs.records.begin()), std::make_move_iterator(rs.records.end()));
   }
-  return compare_records(records, pairs, paper, inputs, common_episodes);
+  return compare_records(records, pairs, paper, inputs, common_episodes, across_backbones);
 }
 
 }  // namespace actionshift::eval

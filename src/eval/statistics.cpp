@@ -102,6 +102,73 @@ BootstrapInterval paired_success_difference(const std::vector<bool>& candidate,
   return percentile_bootstrap(d, confidence, samples, seed);
 }
 
+BootstrapInterval hierarchical_bootstrap(const ClusteredValues& values, double confidence, std::size_t samples,
+                                         std::uint64_t seed) {
+  check_bootstrap_args(confidence, samples);
+  const auto bad = [](const std::string& what) { throw std::invalid_argument("hierarchical_bootstrap: " + what); };
+  if (values.empty()) bad("no backbone");
+  // the blocks' means: the innermost level is never resampled within (a block is kept whole)
+  std::vector<std::vector<std::vector<double>>> block_means(values.size());
+  std::size_t episodes = 0;
+  for (std::size_t b = 0; b < values.size(); ++b) {
+    if (values[b].empty()) bad("backbone " + std::to_string(b) + " has no seed");
+    for (std::size_t s = 0; s < values[b].size(); ++s) {
+      if (values[b][s].empty()) bad("backbone " + std::to_string(b) + ", seed " + std::to_string(s) + " has no block");
+      std::vector<double> means;
+      for (const auto& block : values[b][s]) {
+        if (block.empty()) bad("an empty block");
+        double sum = 0.0;
+        for (double v : block) {
+          if (!std::isfinite(v)) bad("values must be finite");
+          sum += v;
+        }
+        means.push_back(sum / static_cast<double>(block.size()));
+        episodes += block.size();
+      }
+      block_means[b].push_back(std::move(means));
+    }
+  }
+  const auto mean_of = [](const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return sum / static_cast<double>(v.size());
+  };
+  std::vector<double> backbone_means;
+  for (const auto& seeds : block_means) {
+    std::vector<double> seed_means;
+    for (const auto& blocks : seeds) seed_means.push_back(mean_of(blocks));
+    backbone_means.push_back(mean_of(seed_means));
+  }
+  BoundedRng rng(seed);
+  std::vector<double> stats(samples);
+  for (std::size_t r = 0; r < samples; ++r) {
+    double over_backbones = 0.0;
+    for (std::size_t i = 0; i < block_means.size(); ++i) {
+      const auto& seeds = block_means[rng.below(block_means.size())];
+      double over_seeds = 0.0;
+      for (std::size_t j = 0; j < seeds.size(); ++j) {
+        const auto& blocks = seeds[rng.below(seeds.size())];
+        double over_blocks = 0.0;
+        for (std::size_t k = 0; k < blocks.size(); ++k) over_blocks += blocks[rng.below(blocks.size())];
+        over_seeds += over_blocks / static_cast<double>(blocks.size());
+      }
+      over_backbones += over_seeds / static_cast<double>(seeds.size());
+    }
+    stats[r] = over_backbones / static_cast<double>(block_means.size());
+  }
+  std::sort(stats.begin(), stats.end());
+  BootstrapInterval out;
+  out.estimate = mean_of(backbone_means);
+  const double alpha = (1.0 - confidence) / 2.0;
+  out.lower = linear_quantile(stats, alpha);
+  out.upper = linear_quantile(stats, 1.0 - alpha);
+  out.confidence = confidence;
+  out.samples = samples;
+  out.pairs = episodes;
+  out.seed = seed;
+  return out;
+}
+
 TwoProportionSummary two_proportion_summary(std::int64_t successes_a, std::int64_t total_a,
                                             std::int64_t successes_b, std::int64_t total_b, double z) {
   TwoProportionSummary out;

@@ -184,4 +184,37 @@ expect_rc 0 "compare --common-episodes"
 [ "$(echo "$OUT" | python3 -c 'import json,sys; c=json.load(sys.stdin)["comparisons"][0]; print(c["pairs"], c["unpaired"]["candidate"], c["unpaired"]["baseline"])')" = "4 0 4" ] \
   && ok || bad "--common-episodes should pair 4 episodes and leave 4 of the baseline out"
 
+# --across-backbones: the same pair on two backbones (expert, mlp) and two seeds: per backbone the
+# cluster bootstrap over (seed, block), pooled the hierarchical one; without the flag no such block
+for b in expert mlp; do
+  for seed in 1 2; do
+    for m in oracle no_adapt; do
+      run "$AS" run --task pick_cube --split reference_seen --episodes 6 --threads 1 --progress off --seed "$seed" \
+        --backbone "$b" --method "$m" --out "$TMP/xb"
+      expect_rc 0 "run $m on $b, seed $seed"
+    done
+  done
+done
+run "$AS" compare "$TMP/xb" --pair 'oracle vs no_adapt' --across-backbones
+expect_rc 0 "compare --across-backbones"
+printf '%s\n' "$OUT" >"$TMP/xb.json"
+python3 - "$TMP/xb.json" <<'PY' && ok || bad "compare --across-backbones"
+import json, sys
+j = json.load(open(sys.argv[1]))
+(a,) = j["across_backbones"]
+assert (a["candidate"], a["baseline"], a["task"], a["split"]) == ("oracle", "no_adapt", "pick_cube", "reference_seen")
+assert [b["backbone"] for b in a["backbones"]] == ["expert", "mlp"], a["backbones"]
+for b in a["backbones"]:
+    assert b["seeds"] == 2 and b["difference"]["pairs"] == 12
+    d = b["difference"]
+    assert d["lower"] <= d["estimate"] <= d["upper"] and d["samples"] == 10000
+p = a["pooled"]
+assert p["pairs"] == 24 and p["lower"] <= p["estimate"] <= p["upper"]
+assert abs(p["estimate"] - sum(b["difference"]["estimate"] for b in a["backbones"]) / 2) < 1e-12
+assert a["verdict"] == "holds_on_every_backbone", a  # the oracle restores what the hidden contract breaks, on both
+PY
+run "$AS" compare "$TMP/xb" --pair 'oracle vs no_adapt'
+[ "$(echo "$OUT" | python3 -c 'import json,sys; print("across_backbones" in json.load(sys.stdin))')" = False ] && ok \
+  || bad "compare without --across-backbones should not add the block"
+
 finish

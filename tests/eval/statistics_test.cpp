@@ -174,5 +174,72 @@ TEST(TwoProportion, NewcombeIntervalAndOverlap) {
   EXPECT_GT(far.lower, 0.0);
 }
 
+
+// a backbone of `seeds` seeds x `blocks` blocks of `per_block` episodes, each block's episodes equal
+// (success shared by the block's initial state) and the blocks alternating 1, 0 from `first`
+std::vector<std::vector<std::vector<double>>> correlated_backbone(int seeds, int blocks, int per_block, double offset) {
+  std::vector<std::vector<std::vector<double>>> out(static_cast<std::size_t>(seeds));
+  for (int s = 0; s < seeds; ++s)
+    for (int b = 0; b < blocks; ++b)
+      out[static_cast<std::size_t>(s)].push_back(std::vector<double>(static_cast<std::size_t>(per_block), ((b + s) % 2) + offset));
+  return out;
+}
+
+TEST(HierarchicalBootstrap, EstimateWeighsBackbonesSeedsAndBlocksEqually) {
+  // backbone 0: one seed, blocks {1,1} and {0}: block means 1 and 0 -> 0.5; backbone 1: all 0.25
+  const ClusteredValues v = {{{{1.0, 1.0}, {0.0}}}, {{{0.25}}, {{0.25, 0.25}}}};
+  const auto r = hierarchical_bootstrap(v, 0.95, 2000, 7);
+  EXPECT_DOUBLE_EQ(r.estimate, (0.5 + 0.25) / 2.0);
+  EXPECT_EQ(r.pairs, 6u);
+  EXPECT_LE(r.lower, r.estimate);
+  EXPECT_GE(r.upper, r.estimate);
+  EXPECT_EQ(hierarchical_bootstrap(v, 0.95, 2000, 7), r);  // deterministic
+  EXPECT_NE(hierarchical_bootstrap(v, 0.95, 2000, 8), r);
+}
+
+TEST(HierarchicalBootstrap, ConstantValuesGiveAPointInterval) {
+  const ClusteredValues v = {{{{0.3, 0.3}, {0.3}}, {{0.3}}}};
+  const auto r = hierarchical_bootstrap(v, 0.95, 500, 1);
+  EXPECT_DOUBLE_EQ(r.lower, 0.3);
+  EXPECT_DOUBLE_EQ(r.upper, 0.3);
+}
+
+// Episodes of a block are one unit: an episode bootstrap that treats 9 copies of each block as 9
+// independent episodes is 3 times too narrow; the cluster bootstrap is not fooled by the copies
+TEST(HierarchicalBootstrap, ABlocksEpisodesCountOnceNotPerEpisode) {
+  const auto one = correlated_backbone(3, 40, 1, 0.0), nine = correlated_backbone(3, 40, 9, 0.0);
+  const auto w = [](const BootstrapInterval& i) { return i.upper - i.lower; };
+  const double cluster1 = w(hierarchical_bootstrap({one})), cluster9 = w(hierarchical_bootstrap({nine}));
+  EXPECT_NEAR(cluster9, cluster1, 0.02);
+  std::vector<double> flat;
+  for (const auto& seed : nine)
+    for (const auto& block : seed) flat.insert(flat.end(), block.begin(), block.end());
+  const double naive = w(bootstrap_interval(flat));
+  EXPECT_LT(naive * 2.0, cluster9);  // the naive interval is about a third as wide
+}
+
+// Backbones that disagree: each one's own interval excludes 0, the pooled one (backbone a random
+// effect) includes it; with backbones that agree the pooled interval excludes 0 as each does
+TEST(HierarchicalBootstrap, BackboneVariationWidensThePooledInterval) {
+  const auto up = correlated_backbone(3, 40, 2, 0.6), down = correlated_backbone(3, 40, 2, -1.4);
+  const auto r_up = hierarchical_bootstrap({up}), r_down = hierarchical_bootstrap({down});
+  EXPECT_GT(r_up.lower, 0.0);
+  EXPECT_LT(r_down.upper, 0.0);
+  const auto pooled = hierarchical_bootstrap({up, down, up});
+  EXPECT_LT(pooled.lower, 0.0);
+  EXPECT_GT(pooled.upper, 0.0);
+  const auto agree = hierarchical_bootstrap({up, correlated_backbone(3, 40, 2, 0.55), up});
+  EXPECT_GT(agree.lower, 0.0);
+}
+
+TEST(HierarchicalBootstrap, EmptyLevelsAndNonFiniteValuesAreRefused) {
+  EXPECT_THAT([] { hierarchical_bootstrap({}); }, ThrowsMessage<std::invalid_argument>(HasSubstr("no backbone")));
+  EXPECT_THAT([] { hierarchical_bootstrap({{}}); }, ThrowsMessage<std::invalid_argument>(HasSubstr("has no seed")));
+  EXPECT_THAT([] { hierarchical_bootstrap({{{}}}); }, ThrowsMessage<std::invalid_argument>(HasSubstr("has no block")));
+  EXPECT_THAT([] { hierarchical_bootstrap({{{{}}}}); }, ThrowsMessage<std::invalid_argument>(HasSubstr("empty block")));
+  EXPECT_THAT([] { hierarchical_bootstrap({{{{std::nan("")}}}}); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("finite")));
+}
+
 }  // namespace
 }  // namespace actionshift::eval

@@ -118,12 +118,23 @@ struct CompareInputs {
 /// `common_episodes`: pair only the episodes both cells hold instead of refusing cells whose episode sets
 /// differ (a job's first M episodes are the M-episode job's, so a 50-episode cell pairs with the first 50
 /// of a 200-episode one); each comparison then says in `unpaired` how many episodes of each side it left out.
+///
+/// `across_backbones`: also the comparison's `across_backbones` list. For each same-backbone pair and
+/// each (task, split) where two or more backbones hold both labels: per backbone the paired difference
+/// with the cluster bootstrap over (seed, block), a block being the episodes that share an initial
+/// state (episode_index / the cell's contract count); pooled, hierarchical_bootstrap over backbones,
+/// then seeds, then blocks (the backbone a random effect), each with kBootstrapSamples resamples and
+/// seed kBootstrapSeed; and a verdict: `holds_on_every_backbone` (the pooled interval and every
+/// backbone's exclude 0 with one sign), `holds_on_average` (the pooled interval excludes 0, some
+/// backbone's does not), `depends_on_backbone` (backbones significant with opposite signs, or the
+/// pooled interval includes 0 while some backbone's excludes it) or `not_shown` (no interval excludes 0).
 nlohmann::json compare_records(const std::vector<EpisodeRecord>& records, const std::vector<ComparisonPair>& pairs,
-                               const PaperNumbers& paper, const CompareInputs& inputs = {}, bool common_episodes = false);
+                               const PaperNumbers& paper, const CompareInputs& inputs = {}, bool common_episodes = false,
+                               bool across_backbones = false);
 
 /// load_results of every directory, then compare_records. Throws InputError for a directory without
 /// records (naming it) and as compare_records.
 nlohmann::json compare_directories(const std::vector<std::string>& dirs, const std::vector<ComparisonPair>& pairs,
-                                   const PaperNumbers& paper, bool common_episodes = false);
+                                   const PaperNumbers& paper, bool common_episodes = false, bool across_backbones = false);
 
 }  // namespace actionshift::eval

@@ -75,6 +75,24 @@ BootstrapInterval paired_success_difference(const std::vector<bool>& candidate,
                                             std::size_t samples = kBootstrapSamples,
                                             std::uint64_t seed = kBootstrapSeed);
 
+/// Values grouped by the levels that make them dependent, outermost first: backbone → seed → block →
+/// episodes (a block is the episodes that share an initial state: one per contract of the split).
+using ClusteredValues = std::vector<std::vector<std::vector<std::vector<double>>>>;
+
+/// Hierarchical percentile bootstrap of a mean over clustered values (e.g. paired differences
+/// candidate − baseline). Each resample draws backbones with replacement, within each drawn backbone
+/// its seeds with replacement, within each drawn seed its blocks with replacement, and keeps a drawn
+/// block's episodes whole; its statistic is the mean over the drawn backbones of the mean over their
+/// drawn seeds of the mean over their drawn blocks of the block's mean. `estimate` is that statistic
+/// on the data (every backbone, seed and block weighted equally). Resampling every level (not only
+/// the outermost) counts the variation at each level, so with few backbones the interval errs wide,
+/// not narrow; with one backbone it is the cluster bootstrap over (seed, block). `pairs` is the
+/// number of episodes. Throws std::invalid_argument for an empty level, a non-finite value,
+/// samples == 0 or confidence ∉ (0,1).
+BootstrapInterval hierarchical_bootstrap(const ClusteredValues& values, double confidence = 0.95,
+                                         std::size_t samples = kBootstrapSamples,
+                                         std::uint64_t seed = kBootstrapSeed);
+
 /// Two independent proportions side by side (unpaired): both Wilson intervals, the difference
 /// a − b with Newcombe's hybrid score interval (method 10), and whether the Wilson intervals overlap.
 struct TwoProportionSummary {
