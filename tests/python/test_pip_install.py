@@ -6,7 +6,7 @@ and --no-index, so nothing can be downloaded) install the package into a new
 the installed package (not the build tree's copy: PYTHONPATH is cleared) imports, its
 `__version__` equals `importlib.metadata.version("actionshift")` and the CMake project's version,
 and an environment steps. What it does not: compile the module from scratch. A fresh `pip install .`
-runs CMake on the whole library (about 12 minutes on two cores); here setup.py takes the module
+runs CMake on the whole library (a quarter of an hour or more on two cores); here setup.py takes the module
 this ctest build tree already compiled (ACTIONSHIFT_CMAKE_BUILD_DIR), which is the same target,
 built by the same CMake code for the same interpreter. The source is copied first, so the checkout
 is not written to.
