@@ -333,7 +333,9 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
     pol = policy::make_policy(o.backbone, task, reg);
     if (!o.robot.urdf.empty() || !o.robot.packages.empty()) {
       if (o.robot.urdf.empty()) throw InputError("--package", o.robot.packages.front(), "needs --robot URDF");
-      run.robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages)).description;
+      const sim::RobotSource robot = sim::load_robot_source(o.robot.urdf, sim::parse_package_args(o.robot.packages));
+      run.robot = robot.description;
+      run.robot_sha256 = robot.sha256;  // the verdict names the description it certifies
     }
   } catch (const std::invalid_argument& e) {
     err << "actionshift: error: " << e.what() << "\n";
@@ -379,7 +381,8 @@ int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
   } else {
     const auto& c = v.competence;
     const auto& p = v.identity_parity;
-    out << "Gate 0: " << v.backbone << " on " << v.task << " (" << v.episodes << " episodes, seed " << v.seed << ")\n"
+    out << "Gate 0: " << v.backbone << " on " << v.task << " (" << v.episodes << " episodes, seed " << v.seed
+        << (v.robot_sha256.empty() ? "" : ", robot " + v.robot_sha256.substr(0, 12)) << ")\n"
         << "  competence: success_once " << c.interval.successes << "/" << c.interval.total << " = " << fmt(c.interval.rate)
         << " [" << fmt(c.interval.lower) << ", " << fmt(c.interval.upper) << "], floor " << fmt(c.floor, 2) << " ("
         << policy::gate0_rule_name(c.rule) << "): " << (c.passed ? "pass" : "fail") << "\n"

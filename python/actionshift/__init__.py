@@ -11,6 +11,7 @@ the Gymnasium-style environment classes. See docs/python.md.
 import json as _json
 import os as _os
 import sys as _sys
+import warnings as _warnings
 
 import numpy as _np
 
@@ -30,6 +31,7 @@ from ._native import (  # noqa: F401  (re-exported API)
     decode,
     decode_jacobian,
     encode,
+    episode_seed,
     load_manifest,
     method_needs_calibration,
     method_label,
@@ -46,12 +48,18 @@ from ._native import (  # noqa: F401  (re-exported API)
     tcp_rotation,
 )
 
+__version__ = _native.__version__
+"""This build's version (the CMake project's; ``importlib.metadata.version("actionshift")`` of a pip install)."""
+__git_commit__ = _native.__git_commit__
+"""The commit checked out when CMake configured this build (None if it was not a git checkout)."""
+
 __all__ = [
     "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
-    "builtin_manifests", "decode", "decode_jacobian", "encode", "evaluate", "load_manifest", "make",
+    "builtin_manifests", "decode", "decode_jacobian", "encode", "episode_seed", "evaluate", "load_manifest", "make",
     "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
     "method_rung", "PoolBelief", "ResponseModel",
     "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_method", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
+    "write_frames",
 ]
 
 PROFILES = ("maniskill", "ideal")
@@ -96,10 +104,17 @@ class Box:
         return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
 
 
-def _box(low, high, shape):
+def _box(low, high, shape, dtype=_np.float64):
     if _gym_spaces is not None:
-        return _gym_spaces.Box(low=low, high=high, shape=shape, dtype=_np.float64)
-    return Box(low, high, shape)
+        return _gym_spaces.Box(low=low, high=high, shape=shape, dtype=dtype)
+    return Box(low, high, shape, dtype=dtype)
+
+
+try:  # Gymnasium >= 1.1 names the autoreset modes; the value is the same string without it
+    from gymnasium.vector import AutoresetMode as _AutoresetMode
+    _SAME_STEP = _AutoresetMode.SAME_STEP
+except (ImportError, AttributeError):  # pragma: no cover - depends on the machine
+    _SAME_STEP = "SameStep"
 
 
 _EnvBase = _gym.Env if _gym is not None else object
@@ -130,10 +145,15 @@ def _check_reset_options(options):
 
 def _check_types(where, **values):
     # one-line TypeErrors for the constructor arguments (pybind11's own message spans many lines)
+    real = (int, float, _np.integer, _np.floating)
     kinds = {"task": (str,), "split": (str, type(None)), "rotation": (str,), "profile": (str,),
-             "index": (int, _np.integer), "num_envs": (int, _np.integer), "threads": (int, _np.integer)}
+             "index": (int, _np.integer), "num_envs": (int, _np.integer), "threads": (int, _np.integer),
+             "robot": (str, _os.PathLike, type(None)), "packages": (dict, list, tuple, type(None)),
+             "obs_noise": real, "ignore_terminations": (bool, _np.bool_), "render_mode": (str, type(None)),
+             "width": (int, _np.integer), "height": (int, _np.integer), "camera": (str,),
+             "dtype": (str, type, _np.dtype)}
     for name, value in values.items():
-        if not isinstance(value, kinds[name]) or isinstance(value, bool):
+        if not isinstance(value, kinds[name]) or (isinstance(value, bool) and bool not in kinds[name]):
             want = " or ".join("None" if t is type(None) else t.__name__ for t in kinds[name])
             raise TypeError(f"{where}: {name}: expected {want} (got {type(value).__name__})")
     # ranges the native layer's integer types hold (the split's own size is checked there)
@@ -143,45 +163,131 @@ def _check_types(where, **values):
         raise ValueError(f"{where}: threads: must be 0 (all cores) or a count up to 4096 (got {values['threads']})")
     if "num_envs" in values and not -2 ** 31 < values["num_envs"] < 2 ** 31:
         raise ValueError(f"{where}: num_envs: must be between 1 and {MAX_NUM_ENVS} (got {values['num_envs']})")
+    for side in ("width", "height"):
+        if side in values and not 16 <= values[side] <= 4096:
+            raise ValueError(f"{where}: {side}: must be in 16..4096 pixels, as `actionshift render --size` (got {values[side]})")
+    if values.get("render_mode") not in (None, "rgb_array"):
+        raise ValueError(f"{where}: render_mode: must be None or 'rgb_array' (got {values['render_mode']!r})")
+
+
+_DTYPES = {"float64": _np.float64, "float32": _np.float32}
+
+
+def _check_dtype(where, dtype):
+    name = _np.dtype(dtype).name if isinstance(dtype, (type, _np.dtype)) else dtype
+    if name not in _DTYPES:
+        raise ValueError(f"{where}: dtype: must be 'float64' (the default) or 'float32' (got {dtype!r})")
+    return _DTYPES[name]
+
+
+def _packages_args(where, packages):
+    # {name: dir} (or "NAME=DIR" strings, as --package takes them) -> "NAME=DIR" strings
+    if packages is None:
+        return []
+    if isinstance(packages, dict):
+        out = []
+        for name, path in packages.items():
+            if not isinstance(name, str) or not isinstance(path, (str, _os.PathLike)):
+                raise TypeError(f"{where}: packages: expected {{name: directory}} with str keys and path values")
+            out.append(f"{name}={_os.path.abspath(_os.fspath(path))}")
+        return out
+    if not all(isinstance(p, str) for p in packages):
+        raise TypeError(f"{where}: packages: expected a dict {{name: directory}} or a list of 'NAME=DIR' strings")
+    return [p if "=" not in p else p.split("=", 1)[0] + "=" + _os.path.abspath(p.split("=", 1)[1]) for p in packages]
+
+
+def _robot_arg(robot):
+    return None if robot is None else _os.path.abspath(_os.fspath(robot))
+
+
+def _contract_arg(contract):
+    # a pickled environment keeps its contract as canonical JSON text (make() takes it back)
+    return contract.to_json() if isinstance(contract, Contract) else contract
 
 
 def _check_profile(profile):
     _native.env_config_check(profile)
 
 
+_EPISODE_RULE = """Episodes end at the horizon (``truncated``) or when a safety check ends them
+    (``terminated``, ``info["safety"]`` names the flag); success does not end them: ``info["success"]``
+    reports it at each step, ``info["success_once"]`` and ``info["success_at_end"]`` over the episode.
+    This is the library's runner (what ``actionshift run`` records) and ManiSkill's evaluation setting
+    (``ignore_terminations=True``). With ``ignore_terminations=False`` (ManiSkill's training default),
+    success also ends the episode: ``terminated`` is True at the first successful step."""
+
+
 class Env(_EnvBase):
-    """One Bullet Panda task under a hidden action contract, with Gymnasium's API.
+    __doc__ = """One Bullet Panda task under a hidden action contract, with Gymnasium's API.
 
     ``reset(seed=None, options=None) -> (obs, info)``; ``step(action) -> (obs, reward, terminated,
-    truncated, info)``. ``terminated`` is task success (ManiSkill's convention) or an episode ended by
-    a safety check; ``truncated`` is the horizon. ``info`` holds ``success``, ``success_once``,
-    ``safety`` (``"none"`` or the flag that ended the episode), ``elapsed_steps``,
-    ``episode_return`` and ``clipped_steps``. The contract is never observable through the env.
+    truncated, info)``. ``info`` holds ``success``, ``success_once``, ``success_at_end``, ``safety``
+    (``"none"`` or the flag that ended the episode), ``elapsed_steps``, ``episode_return`` and
+    ``clipped_steps``. The contract is never observable through the env.
+
+    """ + _EPISODE_RULE + """
+
+    ``render_mode="rgb_array"``: ``render()`` draws the current state with the renderer and cameras of
+    ``actionshift render`` (OSMesa, headless), a ``(height, width, 3)`` uint8 array.
     """
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
 
-    def __init__(self, task="pick_cube", contract=None, split=None, index=0, rotation="live", profile="maniskill"):
-        _check_types("make", task=task, split=split, index=index, rotation=rotation, profile=profile)
-        self._env = _native._Env(task, contract, split, int(index), rotation, profile)
+    def __init__(self, task="pick_cube", contract=None, split=None, index=0, rotation="live", profile="maniskill",
+                 robot=None, packages=None, obs_noise=0.0, calibration=None, ignore_terminations=True,
+                 render_mode=None, width=320, height=240, camera="default", dtype="float64"):
+        _check_types("make", task=task, split=split, index=index, rotation=rotation, profile=profile, robot=robot,
+                     packages=packages, obs_noise=obs_noise, ignore_terminations=ignore_terminations,
+                     render_mode=render_mode, width=width, height=height, camera=camera, dtype=dtype)
+        self._dtype = _check_dtype("make", dtype)
+        self._args = dict(task=task, contract=_contract_arg(contract), split=split, index=int(index), rotation=rotation,
+                          profile=profile, robot=_robot_arg(robot), packages=packages, obs_noise=float(obs_noise),
+                          calibration=None, ignore_terminations=bool(ignore_terminations), render_mode=render_mode,
+                          width=int(width), height=int(height), camera=camera, dtype=_np.dtype(self._dtype).name)
+        render = (int(width), int(height), camera) if render_mode == "rgb_array" else None
+        self._env = _native._Env(task, contract, split, int(index), rotation, profile, self._args["robot"],
+                                 _packages_args("make", packages), float(obs_noise), bool(ignore_terminations), render)
+        self.calibration = None if calibration is None else _native._load_calibration(calibration, task, profile)
+        """The response calibration given to make() (a dict, checked against the task and profile) for
+        ``make_adapter(..., calibration=env.calibration)``; None if none was given. The simulation does
+        not read it."""
+        self._args["calibration"] = self.calibration
         n = self._env.obs_dim
-        self.observation_space = _box(-_np.inf, _np.inf, (n,))
-        self.action_space = _box(-1.0, 1.0, (7,))
+        self.observation_space = _box(-_np.inf, _np.inf, (n,), self._dtype)
+        self.action_space = _box(-1.0, 1.0, (7,), self._dtype)
         self.horizon = self._env.horizon
         self.layout = self._env.layout
         self.profile = profile
         self.rotation = rotation
-        self.render_mode = None
+        self.robot_sha256 = self._env.robot_sha256 or None
+        self.obs_noise = float(obs_noise)
+        self.ignore_terminations = bool(ignore_terminations)
+        self.render_mode = render_mode
+
+    def _cast(self, out):
+        if self._dtype is _np.float64:
+            return out
+        return (out[0].astype(self._dtype),) + tuple(out[1:])
 
     def reset(self, *, seed=None, options=None):
         """Start an episode; the initial state is a pure function of ``seed`` (None: the next
         seed of this env's sequence, so ``reset(seed=s)`` then ``reset()`` is reproducible)."""
         _check_seed(seed)
         _check_reset_options(options)
-        return self._env.reset(None if seed is None else int(seed))
+        return self._cast(self._env.reset(None if seed is None else int(seed)))
 
     def step(self, action):
-        return self._env.step(action)
+        return self._cast(self._env.step(action))
+
+    def render(self):
+        """The current state as a ``(height, width, 3)`` uint8 RGB array (``render_mode="rgb_array"``),
+        drawn as ``actionshift render --no-overlay`` draws it; None (with a warning, as Gymnasium does)
+        when the environment was made without a render mode."""
+        if self.render_mode is None:
+            _warnings.warn("render: this environment was made without render_mode; "
+                           "use make(..., render_mode='rgb_array')", stacklevel=2)
+            return None
+        return self._env.render()
 
     @property
     def task(self):
@@ -200,64 +306,148 @@ class Env(_EnvBase):
         touch the world take turns (one lock per environment)."""
         self._env.close()
 
+    def __getstate__(self):
+        # by construction arguments and seed state: the unpickled environment is at an episode
+        # boundary (call reset()); reset() without a seed continues the same seed sequence
+        return {"args": dict(self._args), "last_seed": self._env.last_seed, "robot_sha256": self.robot_sha256}
+
+    def __setstate__(self, state):
+        Env.__init__(self, **state["args"])
+        if self.robot_sha256 != state["robot_sha256"]:
+            raise ValueError(f"unpickle: robot: {self._args['robot']} changed since the environment was pickled "
+                             f"(content {self.robot_sha256}, was {state['robot_sha256']})")
+        self._env.last_seed = state["last_seed"]
+
     def __repr__(self):
         return f"<actionshift.Env {self.task} rotation={self.rotation} profile={self.profile}>"
 
 
 class VecEnv:
-    """``num_envs`` environments stepped together in C++ on worker threads (see make_vec)."""
+    __doc__ = """``num_envs`` environments stepped together in C++ on worker threads (see make_vec), with
+    Gymnasium's vector API: ``single_observation_space``, ``single_action_space``, batched spaces,
+    and same-step autoreset (``metadata["autoreset_mode"]``).
+
+    """ + _EPISODE_RULE + """
+    """
+
+    metadata = {"render_modes": [], "autoreset_mode": _SAME_STEP}
 
     def __init__(self, task="pick_cube", num_envs=1, contract=None, split=None, index=0, rotation="live",
-                 profile="maniskill", threads=0):
+                 profile="maniskill", threads=0, robot=None, packages=None, obs_noise=0.0, calibration=None,
+                 ignore_terminations=True, dtype="float64"):
         _check_types("make_vec", task=task, num_envs=num_envs, split=split, index=index, rotation=rotation,
-                     profile=profile, threads=threads)
-        self._env = _native._VecEnv(task, int(num_envs), contract, split, int(index), rotation, profile, int(threads))
+                     profile=profile, threads=threads, robot=robot, packages=packages, obs_noise=obs_noise,
+                     ignore_terminations=ignore_terminations, dtype=dtype)
+        self._dtype = _check_dtype("make_vec", dtype)
+        self._args = dict(task=task, num_envs=int(num_envs), contract=_contract_arg(contract), split=split,
+                          index=int(index), rotation=rotation, profile=profile, threads=int(threads),
+                          robot=_robot_arg(robot), packages=packages, obs_noise=float(obs_noise), calibration=None,
+                          ignore_terminations=bool(ignore_terminations), dtype=_np.dtype(self._dtype).name)
+        self._env = _native._VecEnv(task, int(num_envs), contract, split, int(index), rotation, profile, int(threads),
+                                    self._args["robot"], _packages_args("make_vec", packages), float(obs_noise),
+                                    bool(ignore_terminations))
+        self.calibration = None if calibration is None else _native._load_calibration(calibration, task, profile)
+        self._args["calibration"] = self.calibration
         self.num_envs = self._env.num_envs
         n = self._env.obs_dim
-        self.single_observation_space = _box(-_np.inf, _np.inf, (n,))
-        self.single_action_space = _box(-1.0, 1.0, (7,))
-        self.observation_space = _box(-_np.inf, _np.inf, (self.num_envs, n))
-        self.action_space = _box(-1.0, 1.0, (self.num_envs, 7))
+        self.single_observation_space = _box(-_np.inf, _np.inf, (n,), self._dtype)
+        self.single_action_space = _box(-1.0, 1.0, (7,), self._dtype)
+        self.observation_space = _box(-_np.inf, _np.inf, (self.num_envs, n), self._dtype)
+        self.action_space = _box(-1.0, 1.0, (self.num_envs, 7), self._dtype)
         self.horizon = self._env.horizon
         self.threads = self._env.threads
+        self.robot_sha256 = self._env.robot_sha256 or None
+        self.ignore_terminations = bool(ignore_terminations)
+        self.render_mode = None
+
+    def _cast(self, out):
+        if self._dtype is _np.float64:
+            return out
+        info = out[-1]
+        if "final_obs" in info:
+            info["final_obs"] = info["final_obs"].astype(self._dtype)
+        return (out[0].astype(self._dtype),) + tuple(out[1:])
 
     def reset(self, *, seed=None, options=None):
-        """Reset every environment; environment i gets seed ``seed + i``."""
+        """Reset every environment; environment i gets seed ``seed + i``. ``info`` holds the keys of
+        ``step``'s (arrays over the environments) and ``seed``."""
         _check_seed(seed)
         _check_reset_options(options)
         if seed is not None and int(seed) + self.num_envs - 1 >= 2 ** 64:
             raise ValueError(f"seed: seed + num_envs - 1 must be below 2**64 (environment i gets seed + i; got {seed})")
-        return self._env.reset(None if seed is None else int(seed))
+        return self._cast(self._env.reset(None if seed is None else int(seed)))
 
     def step(self, actions):
         """``actions`` (num_envs, 7) -> (obs, reward, terminated, truncated, info), arrays over envs.
-        Ended environments are reset at once (next seed of their sequence); their last observation
-        is ``info["final_obs"][i]`` and ``info["autoreset"][i]`` is True."""
-        return self._env.step(actions)
+
+        Same-step autoreset (Gymnasium's ``AutoresetMode.SAME_STEP``, as ManiSkill's vector wrapper): an
+        environment whose episode ends is reset in the same call (next seed of its sequence) and its row
+        of ``obs`` is the new episode's first observation; ``info["final_obs"][i]`` is the ended episode's
+        last observation and ``info["final_info"]`` its info, where ``info["_final_obs"][i]`` (and
+        ``_final_info``, ``autoreset``) is True. ``info`` itself describes the step just taken (for an
+        ended environment, its episode's last step), as in ManiSkill."""
+        return self._cast(self._env.step(actions))
 
     def close(self):
         """Free every environment's simulation and the worker threads; later reset/step raise
         RuntimeError("environment is closed ..."); closing again does nothing."""
         self._env.close()
 
+    def __getstate__(self):
+        # by construction arguments and seed state, as Env: the unpickled environments need reset()
+        return {"args": dict(self._args), "last_seed": self._env.last_seed, "robot_sha256": self.robot_sha256}
 
-def make(task="pick_cube", contract=None, split=None, index=0, profile="maniskill", rotation="live"):
+    def __setstate__(self, state):
+        VecEnv.__init__(self, **state["args"])
+        if self.robot_sha256 != state["robot_sha256"]:
+            raise ValueError(f"unpickle: robot: {self._args['robot']} changed since the environment was pickled "
+                             f"(content {self.robot_sha256}, was {state['robot_sha256']})")
+        self._env.last_seed = state["last_seed"]
+
+    def __repr__(self):
+        return f"<actionshift.VecEnv {self._args['task']} num_envs={self.num_envs} profile={self._args['profile']}>"
+
+
+def make(task="pick_cube", contract=None, split=None, index=0, profile="maniskill", rotation="live", *,
+         robot=None, packages=None, obs_noise=0.0, calibration=None, ignore_terminations=True,
+         render_mode=None, width=320, height=240, camera="default", dtype="float64"):
     """An environment for ``task`` under a hidden contract.
 
     contract: an ``actionshift.Contract``, its JSON text or dict; or ``split`` (a built-in split name
     such as ``"seen"``, or a manifest path) and ``index`` (its ``index``-th evaluation contract);
     neither: the identity contract (raw actions are canonical). rotation: ``"live"`` (tool frame =
     TCP orientation) or ``"identity"``. profile: the simulator's fidelity profile (``PROFILES``).
-    """
-    return Env(task, contract=contract, split=split, index=index, rotation=rotation, profile=profile)
+
+    As the CLI's options (docs/sim.md): ``robot`` (a URDF file: another description of the Panda,
+    ``--robot``) with ``packages`` (``{name: directory}`` for ``package://`` paths, ``--package``),
+    ``obs_noise`` (sensor noise sigma in [0, 0.1], ``--obs-noise``) and ``calibration`` (a response
+    calibration for this task and profile, a dict or file as ``--calibration``; kept as
+    ``env.calibration`` for ``make_adapter``). ``ignore_terminations``: the episode-end rule (see
+    ``Env``). ``render_mode="rgb_array"`` with ``width``, ``height`` and ``camera`` (as ``actionshift
+    render --size WxH --camera C``): ``env.render()``. ``dtype``: ``"float64"`` (default) or
+    ``"float32"`` observations and spaces (ManiSkill's)."""
+    return Env(task, contract=contract, split=split, index=index, rotation=rotation, profile=profile, robot=robot,
+               packages=packages, obs_noise=obs_noise, calibration=calibration,
+               ignore_terminations=ignore_terminations, render_mode=render_mode, width=width, height=height,
+               camera=camera, dtype=dtype)
 
 
 def make_vec(task="pick_cube", num_envs=2, contract=None, split=None, index=0, profile="maniskill",
-             rotation="live", threads=0):
+             rotation="live", threads=0, *, robot=None, packages=None, obs_noise=0.0, calibration=None,
+             ignore_terminations=True, dtype="float64"):
     """``num_envs`` environments stepped in C++ on ``threads`` worker threads (0: all cores).
-    With a split, environment i runs evaluation contract ``(index + i) mod n``."""
+    With a split, environment i runs evaluation contract ``(index + i) mod n``. The other arguments
+    are make()'s; episodes end by the same rule as ``Env``'s and autoreset in the same step."""
     return VecEnv(task, num_envs=num_envs, contract=contract, split=split, index=index, rotation=rotation,
-                  profile=profile, threads=threads)
+                  profile=profile, threads=threads, robot=robot, packages=packages, obs_noise=obs_noise,
+                  calibration=calibration, ignore_terminations=ignore_terminations, dtype=dtype)
+
+
+def write_frames(path, frames, delay_cs=10, frame=-1):
+    """Write rendered frames (``env.render()`` arrays) as ``actionshift render`` writes an episode:
+    ``FILE.gif`` (every frame, ``delay_cs`` hundredths of a second each, the last held for a second)
+    or ``FILE.png`` (frame ``frame``; -1: the last)."""
+    return _native.write_frames(_os.fspath(path), list(frames), int(delay_cs), int(frame))
 
 
 def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, calibration=None):

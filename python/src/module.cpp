@@ -19,16 +19,22 @@
 #include "actionshift/eval/experiment.hpp"
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/provenance.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/policy/external.hpp"
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/policy/registry.hpp"
+#include "actionshift/render/camera.hpp"
+#include "actionshift/render/image.hpp"
+#include "actionshift/render/renderer.hpp"
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/verdict.hpp"
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/robot_source.hpp"
+#include "actionshift/sim/scene.hpp"
 #include "actionshift/sim/task.hpp"
 
 #include <pybind11/numpy.h>
@@ -49,10 +55,12 @@
 #include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 namespace py = pybind11;
@@ -296,15 +304,80 @@ sim::EnvConfig env_config_for_profile(const std::string& profile) {
   }
 }
 
-// Env models are immutable and shareable; building one loads the robot, so they are cached.
-std::shared_ptr<const sim::EnvModel> env_model(sim::TaskId task, const std::string& profile) {
+// Env models are immutable and shareable; building one loads the robot, so they are cached, by task,
+// profile, observation noise and robot (its content hash; "" for the embedded Panda).
+std::shared_ptr<const sim::EnvModel> env_model(sim::TaskId task, const std::string& profile, double obs_noise = 0.0,
+                                               const sim::RobotSource* robot = nullptr) {
   static std::mutex mutex;
-  static std::map<std::pair<int, std::string>, std::shared_ptr<const sim::EnvModel>> cache;
-  const sim::EnvConfig config = env_config_for_profile(profile);
+  static std::map<std::tuple<int, std::string, double, std::string>, std::shared_ptr<const sim::EnvModel>> cache;
+  sim::EnvConfig config = env_config_for_profile(profile);
+  config.obs_noise = obs_noise;
   std::lock_guard<std::mutex> lock(mutex);
-  auto& m = cache[{static_cast<int>(task), profile}];
-  if (!m) m = sim::EnvModel::make(task, config);
+  auto& m = cache[{static_cast<int>(task), profile, obs_noise, robot ? robot->sha256 : std::string()}];
+  if (!m) m = sim::EnvModel::make(task, config, robot ? robot->description : nullptr);
   return m;
+}
+
+// What make()/make_vec() take besides the contract, as the CLI's --profile, --obs-noise, --robot and
+// --package (docs/sim.md): checked here, so a bad value is a one-line InputError naming the argument.
+struct EnvOptions {
+  std::string task{"pick_cube"};
+  std::string rotation{"live"}, profile{"maniskill"};
+  std::optional<std::string> robot;   // URDF path (None: the embedded Panda)
+  std::vector<std::string> packages;  // NAME=DIR, as --package
+  double obs_noise{0.0};
+  bool ignore_terminations{true};     // success does not end an episode (the runner's rule)
+};
+
+struct EnvModelRef {
+  std::shared_ptr<const sim::EnvModel> model;
+  std::string robot_sha256;  // "" for the embedded Panda
+};
+
+EnvModelRef resolve_env_model(const std::string& where, const EnvOptions& o) {
+  const sim::TaskId task = sim::parse_task(o.task);
+  if (!(o.obs_noise >= 0.0 && o.obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
+    std::ostringstream got;
+    got << o.obs_noise;
+    throw InputError(where, "obs_noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
+  }
+  if (!o.robot) {
+    if (!o.packages.empty()) throw InputError(where, "packages", "need robot= (a URDF file)");
+    return {env_model(task, o.profile, o.obs_noise), ""};
+  }
+  const sim::RobotSource robot = sim::load_robot_source(*o.robot, sim::parse_package_args(o.packages));
+  return {env_model(task, o.profile, o.obs_noise, &robot), robot.sha256};
+}
+
+// The episode-end rule of Env and VecEnv, the runner's (eval::make_episode_fn): an episode ends at
+// the horizon or when a safety check fires; success ends it only with ignore_terminations=False.
+struct StepFlags {
+  bool terminated{false}, truncated{false};
+  bool ended() const { return terminated || truncated; }
+};
+StepFlags step_flags(const sim::StepResult& r, bool ignore_terminations) {
+  const bool safety = r.safety != sim::SafetyFlag::kNone;
+  return {safety || (!ignore_terminations && r.success), r.truncated && !safety};
+}
+
+// the renderer of make(render_mode="rgb_array"): the CLI's (render::Renderer, the task's cameras)
+struct RenderSetup {
+  int width{320}, height{240};
+  std::string camera{"default"};
+};
+
+render::Camera parse_env_camera(const std::string& where, const std::string& spec, sim::TaskId task) {
+  try {
+    return render::parse_camera(spec, task);
+  } catch (const InputError& e) {
+    throw InputError(where, "camera", e.reason());
+  }
+}
+
+py::array_t<std::uint8_t> image_out(const render::Image& im) {
+  py::array_t<std::uint8_t> out({static_cast<py::ssize_t>(im.height()), static_cast<py::ssize_t>(im.width()), py::ssize_t{3}});
+  std::copy(im.pixels().begin(), im.pixels().end(), out.mutable_data());
+  return out;
 }
 
 sim::FrameRotation parse_rotation(const std::string& r) {
@@ -340,6 +413,7 @@ py::dict step_info(const sim::StepResult& r, const sim::EpisodeStats& st) {
   py::dict info;
   info["success"] = r.success;
   info["success_once"] = st.success_once;
+  info["success_at_end"] = st.success_at_end;
   info["safety"] = std::string(sim::safety_flag_name(r.safety));
   info["elapsed_steps"] = r.elapsed_steps;
   info["episode_return"] = st.episode_return;
@@ -401,12 +475,16 @@ std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
 // results are copied out under the mutex, Python objects are built after. Concurrent calls take turns.
 class PyEnv {
  public:
-  PyEnv(const std::string& task, py::handle contract, std::optional<std::string> split, std::int64_t index,
-        const std::string& rotation, const std::string& profile)
-      : model_(env_model(sim::parse_task(task), profile)),
-        env_(std::make_unique<sim::HiddenContractEnv>(model_, pick_contract(contract, split, index), parse_rotation(rotation))),
-        profile_(profile),
-        rotation_(rotation) {}
+  PyEnv(const EnvOptions& o, py::handle contract, std::optional<std::string> split, std::int64_t index,
+        std::optional<RenderSetup> render)
+      : options_(o),
+        ref_(resolve_env_model("make", o)),
+        env_(std::make_unique<sim::HiddenContractEnv>(ref_.model, pick_contract(contract, split, index), parse_rotation(o.rotation))) {
+    if (render) {
+      render_ = *render;
+      camera_ = parse_env_camera("make", render->camera, ref_.model->task());
+    }
+  }
 
   py::tuple reset(std::optional<std::uint64_t> seed) {
     Eigen::VectorXd obs;
@@ -419,8 +497,10 @@ class PyEnv {
       if (!env_) closed_error();
       s = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
       obs = env_->reset(s);
+      started_ = true;
       last = env_->last();
       episode = env_->episode();
+      ended_.reset();
     }
     py::dict info = step_info(last, episode);
     info["seed"] = s;
@@ -433,40 +513,68 @@ class PyEnv {
       PyErr_Clear();
       value_error("action: not convertible to an array of numbers");
     }
-    if (a.ndim() != 1) value_error("action: must be a 1-D array of 7 numbers (got shape " + shape_of(a) + ")");
+    // every wrong shape is the caller's error, raised before anything is simulated (the library's
+    // environment would end the episode with bad_action_shape, as the runner records it)
+    if (a.ndim() != 1 || a.shape(0) != kActionDim)
+      value_error("action: must have shape (7,) (got " + shape_of(a) + ")");
     const std::span<const double> raw(a.data(), static_cast<std::size_t>(a.shape(0)));
     sim::StepResult r;
     sim::EpisodeStats episode;
+    StepFlags flags;
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
       if (!env_) closed_error();
-      if (!last_seed_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
-      r = env_->step(raw);
+      if (!started_) throw std::runtime_error("step: called before reset() (call env.reset(seed=...) first)");
+      if (ended_) {  // an ended episode returns its last result again (as the library's environment does)
+        r = env_->last();
+        flags = *ended_;
+      } else {
+        r = env_->step(raw);
+        flags = step_flags(r, options_.ignore_terminations);
+        if (flags.ended()) ended_ = flags;
+      }
       episode = env_->episode();
     }
-    const bool safety = r.safety != sim::SafetyFlag::kNone;
-    return py::make_tuple(vec_out(r.obs), r.reward, r.terminated || safety, r.truncated && !safety, step_info(r, episode));
+    return py::make_tuple(vec_out(r.obs), r.reward, flags.terminated, flags.truncated, step_info(r, episode));
+  }
+
+  // the current state drawn by OSMesa from the camera given to make(): (height, width, 3) uint8
+  py::object render() {
+    if (!render_) return py::none();
+    render::Image im;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!env_) closed_error();
+      if (!started_) throw std::runtime_error("render: called before reset() (the scene has no objects until then)");
+      if (!renderer_) renderer_ = std::make_unique<render::Renderer>(render_->width, render_->height);
+      im = renderer_->render(env_->scene(), camera_);
+    }
+    return image_out(im);
   }
 
   // frees the Bullet world; waits for a call of another thread to finish first
   void close() {
     std::unique_ptr<sim::HiddenContractEnv> gone;
+    std::unique_ptr<render::Renderer> renderer;
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
       gone = std::move(env_);
       gone.reset();
+      renderer = std::move(renderer_);
+      renderer.reset();
     }
   }
 
   // fixed at construction: read from the shared model, never from the world
-  std::string task() const { return std::string(sim::task_name(model_->task())); }
-  int horizon() const { return model_->horizon(); }
-  int obs_dim() const { return model_->layout().size(); }
+  std::string task() const { return std::string(sim::task_name(ref_.model->task())); }
+  int horizon() const { return ref_.model->horizon(); }
+  int obs_dim() const { return ref_.model->layout().size(); }
   py::list layout() const {
     py::list out;
-    for (const auto& f : model_->layout().fields()) {
+    for (const auto& f : ref_.model->layout().fields()) {
       py::dict d;
       d["name"] = f.name;
       d["offset"] = f.offset;
@@ -475,15 +583,32 @@ class PyEnv {
     }
     return out;
   }
-  const std::string& profile() const { return profile_; }
-  const std::string& rotation() const { return rotation_; }
+  const std::string& profile() const { return options_.profile; }
+  const std::string& rotation() const { return options_.rotation; }
+  const std::string& robot_sha256() const { return ref_.robot_sha256; }
+  // the seed of the last reset (None before the first): what a pickled environment carries
+  std::optional<std::uint64_t> last_seed() {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_seed_;
+  }
+  void set_last_seed(std::optional<std::uint64_t> s) {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_seed_ = s;
+  }
 
  private:
-  std::shared_ptr<const sim::EnvModel> model_;
-  std::mutex mutex_;                               // guards env_ and last_seed_
+  EnvOptions options_;
+  EnvModelRef ref_;
+  std::mutex mutex_;                               // guards everything below
   std::unique_ptr<sim::HiddenContractEnv> env_;    // null once closed
-  std::string profile_, rotation_;
   std::optional<std::uint64_t> last_seed_;
+  bool started_{false};                            // reset() was called
+  std::optional<StepFlags> ended_;                 // set once the episode has ended
+  std::optional<RenderSetup> render_;
+  render::Camera camera_;
+  std::unique_ptr<render::Renderer> renderer_;     // made at the first render()
 };
 
 // A fixed set of worker threads that run a function over [0, n) in chunks; the caller waits.
@@ -569,13 +694,14 @@ constexpr int kMaxNumEnvs = 4096;
 
 class PyVecEnv {
  public:
-  PyVecEnv(const std::string& task, int num_envs, py::handle contract, std::optional<std::string> split,
-           std::int64_t index, const std::string& rotation, const std::string& profile, unsigned threads)
-      : model_(env_model(sim::parse_task(task), profile)) {
+  PyVecEnv(const EnvOptions& o, int num_envs, py::handle contract, std::optional<std::string> split, std::int64_t index,
+           unsigned threads)
+      : options_(o) {
     if (num_envs < 1 || num_envs > kMaxNumEnvs)
       throw InputError("make_vec", "num_envs", "must be between 1 and " + std::to_string(kMaxNumEnvs) + " (got " +
                                                    std::to_string(num_envs) + ")");
-    const sim::FrameRotation rot = parse_rotation(rotation);
+    ref_ = resolve_env_model("make_vec", o);
+    const sim::FrameRotation rot = parse_rotation(o.rotation);
     std::vector<Contract> contracts;
     if (split && contract.is_none()) {
       const Manifest m = split_manifest(*split);
@@ -586,7 +712,7 @@ class PyVecEnv {
     } else {
       contracts.assign(static_cast<std::size_t>(num_envs), pick_contract(contract, split, index));
     }
-    for (const auto& c : contracts) envs_.emplace_back(model_, c, rot);
+    for (const auto& c : contracts) envs_.emplace_back(ref_.model, c, rot);
     seeds_.assign(static_cast<std::size_t>(num_envs), 0);
     if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
     pool_ = std::make_unique<WorkerPool>(std::min<unsigned>(threads, static_cast<unsigned>(num_envs)));
@@ -596,9 +722,10 @@ class PyVecEnv {
 
   // fixed at construction (readable after close)
   int num_envs() const { return num_envs_; }
-  int obs_dim() const { return model_->layout().size(); }
-  int horizon() const { return model_->horizon(); }
+  int obs_dim() const { return ref_.model->layout().size(); }
+  int horizon() const { return ref_.model->horizon(); }
   unsigned threads() const { return threads_; }
+  const std::string& robot_sha256() const { return ref_.robot_sha256; }
 
   py::tuple reset(std::optional<std::uint64_t> seed) {
     const auto n = static_cast<std::size_t>(num_envs_);
@@ -615,9 +742,10 @@ class PyVecEnv {
         const Eigen::VectorXd& o = envs_[i].reset(seeds_[i]);
         std::copy(o.data(), o.data() + o.size(), out + i * static_cast<std::size_t>(o.size()));
       });
+      started_ = true;
       seeds = seeds_;
     }
-    py::dict info;
+    py::dict info = infos(std::vector<Row>(n));
     info["seed"] = vec_u64(seeds);
     return py::make_tuple(obs, info);
   }
@@ -643,36 +771,21 @@ class PyVecEnv {
     const auto d = static_cast<std::size_t>(obs_dim());
     DArray obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(d)});
     DArray final_obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(d)});
-    py::array_t<double> reward(static_cast<py::ssize_t>(n));
-    py::array_t<bool> term(static_cast<py::ssize_t>(n)), trunc(static_cast<py::ssize_t>(n)), success(static_cast<py::ssize_t>(n)),
-        success_once(static_cast<py::ssize_t>(n)), ended(static_cast<py::ssize_t>(n));
-    std::vector<sim::SafetyFlag> flags(n);
+    std::vector<Row> rows(n);
     const double* in = a.data();
     double* o = obs.mutable_data();
     double* fo = final_obs.mutable_data();
-    double* rw = reward.mutable_data();
-    bool* te = term.mutable_data();
-    bool* tr = trunc.mutable_data();
-    bool* su = success.mutable_data();
-    bool* so = success_once.mutable_data();
-    bool* en = ended.mutable_data();
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
       if (envs_.empty()) closed_error();
-      if (!last_seed_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
+      if (!started_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
       for_each_env([&](std::size_t i) {
         const sim::StepResult& r = envs_[i].step(std::span<const double>(in + i * kActionDim, kActionDim));
-        flags[i] = r.safety;
-        const bool safety = r.safety != sim::SafetyFlag::kNone;
-        rw[i] = r.reward;
-        te[i] = r.terminated || safety;
-        tr[i] = r.truncated && !safety;
-        su[i] = r.success;
-        so[i] = envs_[i].episode().success_once;
-        en[i] = te[i] || tr[i];
+        Row& row = rows[i];
+        row.result_of(r, envs_[i].episode(), step_flags(r, options_.ignore_terminations));
         std::copy(r.obs.data(), r.obs.data() + d, fo + i * d);
-        if (en[i]) {
+        if (row.flags.ended()) {
           seeds_[i] = eval::splitmix64(seeds_[i]);
           const Eigen::VectorXd& first = envs_[i].reset(seeds_[i]);
           std::copy(first.data(), first.data() + d, o + i * d);
@@ -681,18 +794,84 @@ class PyVecEnv {
         }
       });
     }
-    py::dict info;
-    info["success"] = success;
-    info["success_once"] = success_once;
-    py::list names;
-    for (auto f : flags) names.append(std::string(sim::safety_flag_name(f)));
-    info["safety"] = names;
+    py::array_t<double> reward(static_cast<py::ssize_t>(n));
+    py::array_t<bool> term(static_cast<py::ssize_t>(n)), trunc(static_cast<py::ssize_t>(n)), ended(static_cast<py::ssize_t>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      reward.mutable_data()[i] = rows[i].reward;
+      term.mutable_data()[i] = rows[i].flags.terminated;
+      trunc.mutable_data()[i] = rows[i].flags.truncated;
+      ended.mutable_data()[i] = rows[i].flags.ended();
+    }
+    // the info of the step just taken (an ended environment's row: its episode's last step), and,
+    // as Gymnasium's same-step autoreset puts them, the ended episodes' last observation and info
+    py::dict info = infos(rows);
     info["final_obs"] = final_obs;
+    info["_final_obs"] = ended;
+    info["final_info"] = infos(rows);
+    info["_final_info"] = ended;
     info["autoreset"] = ended;
     return py::make_tuple(obs, reward, term, trunc, info);
   }
 
+  // the base seed of the last reset (None before the first): what a pickled environment carries
+  std::optional<std::uint64_t> last_seed() {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_seed_;
+  }
+  void set_last_seed(std::optional<std::uint64_t> s) {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_seed_ = s;
+  }
+
  private:
+  // one environment's step, copied out on its worker thread
+  struct Row {
+    double reward{0.0};
+    StepFlags flags;
+    bool success{false}, success_once{false}, success_at_end{false};
+    sim::SafetyFlag safety{sim::SafetyFlag::kNone};
+    int elapsed_steps{0}, clipped_steps{0};
+    double episode_return{0.0};
+    void result_of(const sim::StepResult& r, const sim::EpisodeStats& st, StepFlags f) {
+      reward = r.reward;
+      flags = f;
+      success = r.success;
+      success_once = st.success_once;
+      success_at_end = st.success_at_end;
+      safety = r.safety;
+      elapsed_steps = r.elapsed_steps;
+      clipped_steps = st.clipped_steps;
+      episode_return = st.episode_return;
+    }
+  };
+  // Env's info keys, one array each (Gymnasium's vector infos)
+  static py::dict infos(const std::vector<Row>& rows) {
+    const auto n = static_cast<py::ssize_t>(rows.size());
+    py::array_t<bool> success(n), success_once(n), success_at_end(n);
+    py::array_t<std::int64_t> elapsed(n), clipped(n);
+    py::array_t<double> ret(n);
+    py::list safety;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      success.mutable_data()[i] = rows[i].success;
+      success_once.mutable_data()[i] = rows[i].success_once;
+      success_at_end.mutable_data()[i] = rows[i].success_at_end;
+      elapsed.mutable_data()[i] = rows[i].elapsed_steps;
+      clipped.mutable_data()[i] = rows[i].clipped_steps;
+      ret.mutable_data()[i] = rows[i].episode_return;
+      safety.append(std::string(sim::safety_flag_name(rows[i].safety)));
+    }
+    py::dict info;
+    info["success"] = success;
+    info["success_once"] = success_once;
+    info["success_at_end"] = success_at_end;
+    info["safety"] = py::module_::import("numpy").attr("array")(safety);
+    info["elapsed_steps"] = elapsed;
+    info["episode_return"] = ret;
+    info["clipped_steps"] = clipped;
+    return info;
+  }
   template <typename F>
   void for_each_env(F&& f) {
     const std::size_t n = envs_.size();
@@ -707,15 +886,73 @@ class PyVecEnv {
     std::copy(v.begin(), v.end(), out.mutable_data());
     return out;
   }
-  std::shared_ptr<const sim::EnvModel> model_;
+  EnvOptions options_;
+  EnvModelRef ref_;
   int num_envs_{0};
   unsigned threads_{1};
   std::mutex mutex_;                          // guards everything below
   std::vector<sim::HiddenContractEnv> envs_;  // empty once closed
   std::vector<std::uint64_t> seeds_;
   std::optional<std::uint64_t> last_seed_;
+  bool started_{false};
   std::unique_ptr<WorkerPool> pool_;
 };
+
+// Frames as `actionshift render` writes them: FILE.gif (every frame, then the last held for a
+// second) or FILE.png (frame `frame`, -1: the last). Frames are (height, width, 3) uint8 arrays.
+void write_frames(const std::string& path, py::handle frames, int delay_cs, int frame) {
+  namespace fs = std::filesystem;
+  const std::string ext = fs::path(path).extension().string();
+  if (ext != ".gif" && ext != ".png") throw InputError(path, "path", "must end in .gif or .png");
+  if (fs::is_directory(path)) throw InputError(path, "path", "is a directory");
+  if (delay_cs < 1 || delay_cs > 1000) throw InputError("write_frames", "delay_cs", "must be in 1..1000");
+  if (!py::isinstance<py::sequence>(frames) || py::isinstance<py::str>(frames))
+    throw py::type_error("write_frames: frames: expected a sequence of (height, width, 3) uint8 arrays");
+  std::vector<render::Image> images;
+  const py::sequence seq = py::reinterpret_borrow<py::sequence>(frames);
+  for (std::size_t k = 0; k < seq.size(); ++k) {
+    const py::object f = seq[k];
+    const std::string what = "frames[" + std::to_string(k) + "]";
+    if (!py::isinstance<py::array>(f) || !py::array(py::reinterpret_borrow<py::array>(f)).dtype().is(py::dtype::of<std::uint8_t>()))
+      throw InputError("write_frames", what, "must be a numpy uint8 array (what env.render() returns)");
+    const auto a = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(f);
+    if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1 || a.shape(0) > 8192 || a.shape(1) > 8192)
+      throw InputError("write_frames", what, "must have shape (height, width, 3) with sides in 1..8192");
+    render::Image im(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
+    std::copy(a.data(), a.data() + a.size(), im.mutable_pixels().begin());
+    if (!images.empty() && (im.width() != images.front().width() || im.height() != images.front().height()))
+      throw InputError("write_frames", what, "has another size than frames[0]");
+    images.push_back(std::move(im));
+  }
+  if (images.empty()) throw InputError("write_frames", "frames", "no frame to write");
+  py::gil_scoped_release release;
+  if (ext == ".png") {
+    if (frame < -1 || frame >= static_cast<int>(images.size()))
+      throw InputError("write_frames", "frame", std::to_string(frame) + " is outside 0.." + std::to_string(images.size() - 1) + " (-1: the last)");
+    render::write_png(path, frame < 0 ? images.back() : images[static_cast<std::size_t>(frame)]);
+    return;
+  }
+  const render::Image last = images.back();
+  for (int i = 0; i < 10; ++i) images.push_back(last);  // hold the outcome for a second, as the CLI does
+  render::write_gif(path, images, delay_cs);
+}
+
+// make(calibration=...): a response calibration (a dict as `calibrate --json` writes it, or its file)
+// measured for this task on this profile; returned as its canonical dict
+py::object load_calibration(py::handle calibration, const std::string& task, const std::string& profile) {
+  const std::string t(sim::task_name(sim::parse_task(task)));
+  adapt::ResponseCalibration cal;
+  if (py::isinstance<py::dict>(calibration)) {
+    cal = adapt::ResponseCalibration::from_json(py_to_json(calibration, "calibration"), "calibration");
+    if (cal.task != t) throw InputError("calibration", "task", "is " + cal.task + ", not the environment's " + t);
+    const std::string base = cal.profile.substr(0, cal.profile.find('['));
+    if (base != profile) throw InputError("calibration", "profile", "was measured on " + cal.profile + ", not on the environment's " + profile);
+  } else {
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(calibration)).cast<std::string>();
+    cal = adapt::ResponseCalibration::load_for(path, t, "the environment's " + t, profile, "the environment's " + profile);
+  }
+  return json_to_py(cal.to_json());
+}
 
 // The C++ baseline of the per-step benchmark (tests/bench/python_bench.py): the same control loop
 // as stepping an Env from Python (identity contract, reset with seed, seed+1, ... at each episode
@@ -1453,29 +1690,57 @@ PYBIND11_MODULE(_native, m) {
 
   // ---- environments
   py::class_<PyEnv>(m, "_Env")
-      .def(py::init<const std::string&, py::handle, std::optional<std::string>, std::int64_t, const std::string&, const std::string&>(),
-           py::arg("task"), py::arg("contract"), py::arg("split"), py::arg("index"), py::arg("rotation"), py::arg("profile"))
+      .def(py::init([](const std::string& task, py::handle contract, std::optional<std::string> split, std::int64_t index,
+                       const std::string& rotation, const std::string& profile, std::optional<std::string> robot,
+                       std::vector<std::string> packages, double obs_noise, bool ignore_terminations,
+                       std::optional<std::tuple<int, int, std::string>> render) {
+             EnvOptions o{task, rotation, profile, std::move(robot), std::move(packages), obs_noise, ignore_terminations};
+             std::optional<RenderSetup> r;
+             if (render) r = RenderSetup{std::get<0>(*render), std::get<1>(*render), std::get<2>(*render)};
+             return std::make_unique<PyEnv>(o, contract, std::move(split), index, r);
+           }),
+           py::arg("task"), py::arg("contract"), py::arg("split"), py::arg("index"), py::arg("rotation"), py::arg("profile"),
+           py::arg("robot"), py::arg("packages"), py::arg("obs_noise"), py::arg("ignore_terminations"), py::arg("render"))
       .def("reset", &PyEnv::reset, py::arg("seed") = py::none())
       .def("step", &PyEnv::step, py::arg("action"))
+      .def("render", &PyEnv::render)
       .def("close", &PyEnv::close)
+      .def_property("last_seed", &PyEnv::last_seed, &PyEnv::set_last_seed)
       .def_property_readonly("task", &PyEnv::task)
       .def_property_readonly("horizon", &PyEnv::horizon)
       .def_property_readonly("obs_dim", &PyEnv::obs_dim)
       .def_property_readonly("layout", &PyEnv::layout)
       .def_property_readonly("profile", &PyEnv::profile)
-      .def_property_readonly("rotation", &PyEnv::rotation);
+      .def_property_readonly("rotation", &PyEnv::rotation)
+      .def_property_readonly("robot_sha256", &PyEnv::robot_sha256);
   py::class_<PyVecEnv>(m, "_VecEnv")
-      .def(py::init<const std::string&, int, py::handle, std::optional<std::string>, std::int64_t, const std::string&,
-                    const std::string&, unsigned>(),
+      .def(py::init([](const std::string& task, int num_envs, py::handle contract, std::optional<std::string> split,
+                       std::int64_t index, const std::string& rotation, const std::string& profile, unsigned threads,
+                       std::optional<std::string> robot, std::vector<std::string> packages, double obs_noise,
+                       bool ignore_terminations) {
+             EnvOptions o{task, rotation, profile, std::move(robot), std::move(packages), obs_noise, ignore_terminations};
+             return std::make_unique<PyVecEnv>(o, num_envs, contract, std::move(split), index, threads);
+           }),
            py::arg("task"), py::arg("num_envs"), py::arg("contract"), py::arg("split"), py::arg("index"),
-           py::arg("rotation"), py::arg("profile"), py::arg("threads"))
+           py::arg("rotation"), py::arg("profile"), py::arg("threads"), py::arg("robot"), py::arg("packages"),
+           py::arg("obs_noise"), py::arg("ignore_terminations"))
       .def("reset", &PyVecEnv::reset, py::arg("seed") = py::none())
       .def("step", &PyVecEnv::step, py::arg("actions"))
       .def("close", &PyVecEnv::close)
+      .def_property("last_seed", &PyVecEnv::last_seed, &PyVecEnv::set_last_seed)
       .def_property_readonly("num_envs", &PyVecEnv::num_envs)
       .def_property_readonly("obs_dim", &PyVecEnv::obs_dim)
       .def_property_readonly("horizon", &PyVecEnv::horizon)
-      .def_property_readonly("threads", &PyVecEnv::threads);
+      .def_property_readonly("threads", &PyVecEnv::threads)
+      .def_property_readonly("robot_sha256", &PyVecEnv::robot_sha256);
+  m.def("write_frames", &write_frames, py::arg("path"), py::arg("frames"), py::arg("delay_cs"), py::arg("frame"));
+  m.def("episode_seed", [](py::handle seed, py::handle contract_episode) {
+    return eval::episode_seed(to_seed(seed, "seed"), to_int(contract_episode, "contract_episode", 0, std::int64_t{1} << 62));
+  }, py::arg("seed"), py::arg("contract_episode"),
+        "The environment seed of a job's episode (the runner's episode_seed): every contract's episode k starts from it.");
+  m.def("_load_calibration", &load_calibration, py::arg("calibration"), py::arg("task"), py::arg("profile"));
+  m.attr("__version__") = eval::build_provenance().version;
+  m.attr("__git_commit__") = eval::build_provenance().git_commit.empty() ? py::object(py::none()) : py::object(py::str(eval::build_provenance().git_commit));
   m.def("tasks", [] {
     std::vector<std::string> out;
     for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t));

@@ -166,7 +166,10 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   return out;
 }
 
-std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& p, const MethodInputs& in) {
+std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& given, const MethodInputs& in) {
+  // resolved here as well (resolving resolved parameters changes nothing): a missing parameter takes
+  // its default and a wrong one is a one-line InputError, never a JSON library exception
+  const nlohmann::json p = resolve_method_params(method, given);
   if (const auto plugin = find_method_plugin(method)) {
     // exactly what the declared rung allows: never the truth; the pool only to the pool rung
     PluginInputs pi;

@@ -101,6 +101,8 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
 
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   if (run.episodes <= 0) throw std::invalid_argument("at least one episode is required");
+  if (run.robot && run.robot_sha256.empty())
+    throw InputError("gate0", "robot_sha256", "a robot description needs its content hash (sim::load_robot_source), which the verdict records");
   auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile), run.robot);
   RolloutOptions o;
   o.seed = run.seed;
@@ -116,6 +118,7 @@ Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   Gate0Verdict v = gate0_verdict(policy.name(), policy.sha256(), policy.task(), unwrapped, identity, floor, run.rule);
   v.seed = run.seed;
   v.profile = run.profile;
+  v.robot_sha256 = run.robot ? run.robot_sha256 : std::string();
   return v;
 }
 
@@ -130,7 +133,9 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
   bool all = !verdicts.empty();
   for (const auto& v : verdicts) {
     all = all && v.passed;
-    j["cells"][v.backbone + "/" + v.task] = {
+    const std::string key = v.backbone + "/" + v.task + (v.robot_sha256.empty() ? "" : "@robot:" + v.robot_sha256.substr(0, 12));
+    nlohmann::json& cell = j["cells"][key];
+    cell = {
         {"backbone", v.backbone},
         {"backbone_sha256", v.backbone_sha256},
         {"task", v.task},
@@ -150,6 +155,7 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
         {"oracle_parity", nullptr},
         {"success_at_end", v.success_at_end_unwrapped},
         {"safety_flagged", {{"unwrapped", v.flagged_unwrapped}, {"identity", v.flagged_identity}}}};
+    if (!v.robot_sha256.empty()) cell["robot"] = {{"sha256", v.robot_sha256}};
   }
   j["passed"] = all;
   return j;

@@ -122,13 +122,16 @@ ReportResult write_report(const std::string& results_dir, const std::string& out
   write_text(out / "summary.json", eval::summary_to_json(cells).dump(2) + "\n");
   for (const auto& v : verdicts) write_text(out / "verdicts" / v.name, v.doc.dump(2) + "\n");
 
-  // provenance values recorded by the job specs (profile and commit appear when the files carry them)
+  // provenance: the profile from the job specs, the commit from the records' provenance.git_commit
   std::set<std::string> profiles, commits;
   for (const auto& j : jobs) {
     const json& spec = j.summary.contains("job") ? j.summary["job"] : json::object();
     if (spec.contains("profile")) profiles.insert(str_field(spec, "profile"));
-    for (const json* o : {&spec, &j.summary})
-      if (o->contains("commit")) commits.insert(str_field(*o, "commit"));
+  }
+  std::size_t without_commit = 0;
+  for (const auto& r : results.records) {
+    if (r.git_commit.empty()) ++without_commit;
+    else commits.insert(r.git_commit);
   }
   auto joined = [](const std::set<std::string>& s, const std::string& none) {
     if (s.empty()) return none;
@@ -137,7 +140,9 @@ ReportResult write_report(const std::string& results_dir, const std::string& out
     return out;
   };
   const std::string profile_text = joined(profiles, "not recorded in the job specs");
-  const std::string commit_text = joined(commits, "not recorded in the result files");
+  std::string commit_text = joined(commits, "not recorded in the result files");
+  if (!commits.empty() && without_commit > 0)
+    commit_text += " (and " + std::to_string(without_commit) + " records without one)";
   std::set<std::string> summarised;  // job ids with a row in the job table
   for (const auto& j : jobs) summarised.insert(j.id);
   std::size_t complete = 0;

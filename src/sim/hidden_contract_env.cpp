@@ -3,6 +3,7 @@
 
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/transforms.hpp"
+#include "actionshift/sim/scene.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -86,5 +87,7 @@ Action OracleRecorder::encode(const Action& canonical) const {
 std::span<const Action> OracleRecorder::decoded() const { return env_->impl_->decoded; }
 std::span<const Action> OracleRecorder::applied() const { return env_->impl_->applied; }
 const Env& OracleRecorder::env() const { return env_->impl_->env; }
+
+Scene HiddenContractEnv::scene() const { return scene_of(impl_->env); }
 
 }  // namespace actionshift::sim

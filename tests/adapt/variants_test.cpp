@@ -70,6 +70,28 @@ TEST(MethodDefaults, TheRegistrysEntropyProbesIsTheStructDefaultAndTheVariantDif
   EXPECT_GT(differ, 0) << "the calibrated variant never chose another probe: it would not be a variant";
 }
 
+TEST(MakeAdapter, UnresolvedParametersTakeDefaultsAndBadOnesAreOneLineErrors) {
+  // a C++ integrator calling make_adapter directly: {} is the paper's method (it was a raw JSON
+  // exception, "key 'budget' not found"); a bad value names the method and the field on one line
+  const ResponseModel model = pick_like();
+  MethodInputs in;
+  const auto pool = reference::pool9();
+  in.pool = &pool;
+  in.model = &model;
+  auto partial = make_adapter("entropy_probes", nlohmann::json::object(), in);
+  auto resolved = make_adapter("entropy_probes", resolve_method_params("entropy_probes"), in);
+  EXPECT_EQ(probes_of(*partial, pool[3]), probes_of(*resolved, pool[3]));
+  auto one_line = [](const std::string& field) {
+    return ThrowsMessage<InputError>(::testing::AllOf(HasSubstr("method entropy_probes: " + field),
+                                                      ::testing::Not(HasSubstr("\n"))));
+  };
+  EXPECT_THAT([&] { make_adapter("entropy_probes", {{"budget", "six"}}, in); }, one_line("budget: wrong type"));
+  EXPECT_THAT([&] { make_adapter("entropy_probes", {{"budget", -1}}, in); }, one_line("budget: must be in [0, 1000]"));
+  EXPECT_THAT([&] { make_adapter("entropy_probes", {{"budgte", 6}}, in); }, one_line("budgte: unknown parameter"));
+  EXPECT_THAT([&] { make_adapter("dualabi", {{"tau", 1.5}}, MethodInputs{}); },
+              ThrowsMessage<InputError>(HasSubstr("needs a pool")));
+}
+
 TEST(MethodLabels, CanonicalLabelsRoundTrip) {
   const auto label = [](const std::string& text) {
     const MethodLabel l = parse_method_label(text);

@@ -79,8 +79,20 @@ run "$AS" bench env --task pick_cube --steps 50 --threads 1 --robot "$URDF" --pa
 expect_rc 0 "bench env --robot"
 run "$AS" calibrate --task pick_cube --episodes 1 --steps 5 --robot "$URDF" --package "$PKG"
 expect_rc 0 "calibrate --robot"
-run "$AS" gate0 --task pick_cube --episodes 2 --threads 1 --quiet --robot "$URDF" --package "$PKG"
+run "$AS" gate0 --task pick_cube --episodes 2 --threads 1 --quiet --robot "$URDF" --package "$PKG" --out "$TMP/gate0-robot.json"
 [ "$RC" = 0 ] || [ "$RC" = 1 ] && ok || bad "gate0 --robot: exit $RC ($ERR)"
+run "$AS" gate0 --task pick_cube --episodes 2 --threads 1 --quiet --out "$TMP/gate0-embedded.json"
+[ "$RC" = 0 ] || [ "$RC" = 1 ] && ok || bad "gate0 embedded: exit $RC ($ERR)"
+# the verdict names the description it certifies: its cell id carries the robot hash (that of the
+# job run above on the same, changed-mesh description), and the embedded Panda's verdict has neither
+python3 - "$TMP/gate0-robot.json" "$TMP/gate0-embedded.json" "$TMP"/changed/*.summary.json <<'PY' && ok || bad "gate0 --robot verdict must record the robot's hash"
+import json, sys
+robot, embedded = json.load(open(sys.argv[1]))["cells"], json.load(open(sys.argv[2]))["cells"]
+sha = json.load(open(sys.argv[3]))["job"]["robot"]["sha256"]
+assert list(embedded) == ["expert/pick_cube"] and "robot" not in embedded["expert/pick_cube"], embedded.keys()
+assert list(robot) == ["expert/pick_cube@robot:" + sha[:12]], list(robot)
+assert robot["expert/pick_cube@robot:" + sha[:12]]["robot"] == {"sha256": sha}
+PY
 run "$AS" selftest --sim --task pick_cube --hidden-contract identity --robot "$URDF" --package "$PKG"
 [ "$RC" = 0 ] || [ "$RC" = 1 ] || [ "$RC" = 2 ] && ok || bad "selftest --sim --robot: exit $RC ($ERR)"
 

@@ -2,6 +2,8 @@
 // run compared with the committed expected verdict
 #include "actionshift/policy/gate0.hpp"
 #include "actionshift/policy/registry.hpp"
+#include "actionshift/core/error.hpp"
+#include "actionshift/sim/robot_description.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -60,6 +62,29 @@ TEST(Gate0, ExcludesAPolicyThatDoesNothing) {
   EXPECT_EQ(v.decision, "exclude");
   EXPECT_THAT(v.reason, HasSubstr("competence: success Wilson lower bound 0.0000 below floor 0.5000"));
   EXPECT_TRUE(v.identity_parity.passed);
+}
+
+TEST(Gate0, AVerdictOnAUserRobotNamesItsHashInTheCellKeyAndCell) {
+  // counts only: the verdict file of the embedded Panda is unchanged; a user robot's verdict is
+  // another cell (its id carries the description's hash) that records the full hash
+  std::vector<policy::EpisodeOutcome> all(10);
+  for (auto& e : all) e.success_once = e.success_at_end = true;
+  policy::Gate0Verdict v = policy::gate0_verdict("expert", std::string(64, 'b'), sim::TaskId::kPickCube, all, all, 0.5,
+                                                 policy::Gate0Rule::kWilsonLower);
+  const nlohmann::json embedded = policy::gate0_to_json({v});
+  ASSERT_TRUE(embedded.at("cells").contains("expert/pick_cube"));
+  EXPECT_FALSE(embedded.at("cells").at("expert/pick_cube").contains("robot"));
+  v.robot_sha256 = "0123456789ab" + std::string(52, 'f');
+  const nlohmann::json user = policy::gate0_to_json({v});
+  ASSERT_EQ(user.at("cells").size(), 1u);
+  ASSERT_TRUE(user.at("cells").contains("expert/pick_cube@robot:0123456789ab")) << user.dump();
+  EXPECT_EQ(user.at("cells").at("expert/pick_cube@robot:0123456789ab").at("robot").at("sha256"), v.robot_sha256);
+  // a run with a robot description must name it
+  policy::Gate0Run run;
+  run.episodes = 1;
+  run.robot = std::make_shared<const sim::RobotDescription>(sim::panda_description());
+  EXPECT_THAT([&] { policy::run_gate0(*policy::make_policy("expert", sim::TaskId::kPickCube), run); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("robot_sha256")));
 }
 
 // Smoke: 20 episodes of a backbone compared with configs/gates/gate0/smoke/<backbone>.<task>.json.

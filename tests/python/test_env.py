@@ -67,7 +67,6 @@ def test_observation_is_a_fresh_array_each_step():
 
 @pytest.mark.parametrize("action,flag", [
     ([math.nan, 0, 0, 0, 0, 0, 0], "nonfinite_action"),
-    ([0, 0, 0], "bad_action_shape"),
     ([1e9, 0, 0, 0, 0, 0, 0], "action_out_of_range"),
 ])
 def test_safety_flags_end_the_episode(action, flag):
@@ -77,6 +76,17 @@ def test_safety_flags_end_the_episode(action, flag):
     assert terminated and not truncated
     assert info["safety"] == flag
     assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("shape", [(6,), (8,), (0,), (), (1, 7), (7, 1), (2, 7)])
+def test_every_wrong_action_shape_is_a_value_error_and_simulates_nothing(shape):
+    # np.zeros(6) used to end the episode with the safety flag bad_action_shape while (1, 7) raised
+    env = actionshift.make("pick_cube")
+    env.reset(seed=1)
+    with pytest.raises(ValueError, match=r"action: must have shape \(7,\) \(got"):
+        env.step(np.zeros(shape))
+    obs, reward, terminated, truncated, info = env.step(np.zeros(7))  # the episode goes on
+    assert info["elapsed_steps"] == 1 and info["safety"] == "none" and not terminated
 
 
 def test_hidden_contract_remaps_actions_and_is_not_observable():

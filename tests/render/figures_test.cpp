@@ -120,7 +120,13 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
   const fs::path root = fs::temp_directory_path() / ("actionshift_report_" + std::to_string(::getpid()));
   fs::remove_all(root);
   fs::create_directories(root / "results");
-  const auto recs = concat({cell("pick_cube", "seen", "oracle", 8, 8, 0), cell("pick_cube", "seen", "no_adapt", 8, 0, 0)});
+  auto recs = concat({cell("pick_cube", "seen", "oracle", 8, 8, 0), cell("pick_cube", "seen", "no_adapt", 8, 0, 0)});
+  const std::string commit = "0123456789abcdef0123456789abcdef01234567";
+  for (auto& r : recs)
+    if (r.method == "oracle") {  // records carry provenance {actionshift_version, git_commit}; the no_adapt ones none
+      r.actionshift_version = "0.1.0";
+      r.git_commit = commit;
+    }
   {
     // the summary below is written by hand for this test, not the oracle job's own: its records are in a file of another name,
     // so that load_results does not check them against it (records_sha256)
@@ -144,6 +150,8 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
   ss << f.rdbuf();
   const std::string html = ss.str();
   EXPECT_THAT(html, HasSubstr("Simulator profile: ideal."));
+  // the commit comes from the records' provenance.git_commit (the page said "not recorded" before)
+  EXPECT_THAT(html, HasSubstr("Commit: " + commit + " (and 8 records without one)."));
   EXPECT_THAT(html, HasSubstr("oracle 1.0000, no_adapt 0.0000"));
   EXPECT_THAT(html, HasSubstr("id=\"job-" + std::string(63, 'a') + "6\""));
   // every src / href target exists (a file under out, or an element id of the page)

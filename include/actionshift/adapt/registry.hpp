@@ -74,8 +74,10 @@ nlohmann::json merge_method_params(const MethodLabel& label, const nlohmann::jso
 /// (`method_variant`), so two variants of one method are two cells.
 std::string method_variant_label(const std::string& method, const nlohmann::json& resolved_params);
 
-/// Builds an adapter. `params` must be resolved (resolve_method_params). Throws InputError when a
-/// required input is missing (no pool for a pool method, no truth for the oracle).
+/// Builds an adapter. `params` are resolved here (resolve_method_params: missing keys take their
+/// defaults, so `{}` is the paper's method). Throws InputError, one line naming the method and the
+/// field, for an unknown method or parameter, a value of the wrong type or range, and a missing
+/// input (no pool for a pool method, no truth for the oracle).
 std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann::json& params, const MethodInputs& in);
 
 }  // namespace actionshift::adapt

@@ -77,12 +77,16 @@ struct Gate0Run {
   unsigned threads{0};
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (finished, total) over both runs
   std::shared_ptr<const sim::RobotDescription> robot;  ///< nullptr: the embedded Panda
+  /// The robot's content hash (sim::load_robot_source's sha256); required with `robot`, so that the
+  /// verdict names the description it certifies.
+  std::string robot_sha256;
 };
 
 /// A Gate 0 verdict for one backbone and task.
 struct Gate0Verdict {
   std::string backbone, backbone_sha256, task;
   std::string profile{"maniskill"};  ///< simulator fidelity profile the episodes ran on
+  std::string robot_sha256;          ///< content hash of a user-supplied robot description; "" for the embedded Panda
   std::uint64_t seed{0};
   std::int64_t episodes{0};
   Gate0Competence competence;
@@ -103,7 +107,9 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view backbone_
 /// derive_seed({seed, 0, k})), on all cores. Rethrows a policy failure.
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run);
 
-/// Verdict file of several cells (deterministic: no timing, sorted keys).
+/// Verdict file of several cells (deterministic: no timing, sorted keys). A cell's key is
+/// "<backbone>/<task>", and "<backbone>/<task>@robot:<first 12 hex of the robot hash>" with a
+/// user-supplied robot, whose cell also holds "robot": {"sha256": ...}.
 nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts);
 /// "wilson_lower" | "point_estimate"; parse throws actionshift::InputError (field "rule").
 std::string_view gate0_rule_name(Gate0Rule rule);

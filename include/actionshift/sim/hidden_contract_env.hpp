@@ -23,6 +23,7 @@ namespace actionshift::sim {
 namespace detail {
 struct HiddenEnvImpl;
 }
+struct Scene;
 
 /// Which rotation the decoder's `tool` frame uses.
 enum class FrameRotation {
@@ -54,6 +55,9 @@ class HiddenContractEnv {
   const ObservationLayout& layout() const;
   TaskId task() const;
   int horizon() const;
+  /// What a renderer draws (sim::scene_of of the wrapped environment): shapes and poses, nothing of
+  /// the contract. Call it after reset().
+  Scene scene() const;
 
  private:
   friend class OracleRecorder;
