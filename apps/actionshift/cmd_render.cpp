@@ -2,6 +2,7 @@
 #include "cmd_render.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/eval/job.hpp"
 #include "actionshift/eval/experiment.hpp"
 #include "actionshift/render/episode.hpp"
 #include "actionshift/render/image.hpp"
@@ -97,7 +98,11 @@ int run_render(const RenderOptions& o) {
       throw InputError("command line", "--contract", std::to_string(o.contract) + " is outside the split's " +
                                                          std::to_string(job.split.contracts) + " contracts");
     if (o.episode < 0) throw InputError("command line", "--episode", "must be >= 0");
-    const std::int64_t index = o.episode * job.split.contracts + o.contract;
+    // the job's episode that runs contract I in block E: the contracts of a block run in a seeded order
+    // (eval::deal_permutation), so it is not E * contracts + I
+    const auto order = eval::deal_permutation(job.seed, job.split.contracts, o.episode);
+    const std::int64_t index =
+        o.episode * job.split.contracts + (std::find(order.begin(), order.end(), o.contract) - order.begin());
     if (index >= job.episodes)
       throw InputError("command line", "--episode", "contract " + std::to_string(o.contract) + " has no episode " +
                                                         std::to_string(o.episode) + " in a job of " +

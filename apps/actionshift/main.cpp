@@ -703,7 +703,8 @@ int main(int argc, char** argv) {
       "Render one episode of a job headless (OSMesa) exactly as `run` runs it: same job id, contract, episode\n"
       "seed, initial state and outcome as that episode's JSONL record, which is printed as one JSON line.\n"
       "Writes an animated GIF (every step) or a PNG (one frame) with an overlay of the step, the phase\n"
-      "(reset / probe / act) and success. Episode E of contract I is the job's episode E * contracts + I.");
+      "(reset / probe / act) and success. Episode E of contract I is the one of block E (the job's episodes\n"
+      "E * contracts ... E * contracts + contracts - 1, in a seeded order) that runs contract I.");
   add_job_options(render, render_o.job, /*required=*/true);
   render->add_option("--step-timeout", render_o.step_timeout_s, "Seconds an external:<command> backbone may take per step (as for run)")
       ->check(CLI::Range(0.001, 86400.0) & kNotNan)

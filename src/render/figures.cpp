@@ -234,6 +234,81 @@ std::vector<Figure> ladder_figures(const std::vector<eval::CellSummary>& cells) 
   return out;
 }
 
+namespace {
+// the ladder of the paper's Fig. 4, bottom to top: no adaptation, grammar knowledge, pool belief, the
+// ceiling; a label sorts by its base name, variants after the base
+int ladder_rung(const std::string& label) {
+  static const std::vector<std::string> order{"no_adapt",     "osi",          "probe_osi",      "recurrent_osi",
+                                              "grammar_belief", "fixed_probes", "random_probes", "entropy_probes",
+                                              "exact_belief", "dualabi",      "oracle"};
+  const std::string base = label.substr(0, label.find('{'));
+  const auto it = std::find(order.begin(), order.end(), base);
+  return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
+}
+bool rung_less(const std::string& a, const std::string& b) {
+  const int ra = ladder_rung(a), rb = ladder_rung(b);
+  return ra != rb ? ra < rb : a < b;
+}
+// a backbone's legend name: a weight file by its file name
+std::string backbone_label(const std::string& b) {
+  const auto slash = b.rfind('/');
+  return slash == std::string::npos ? b : b.substr(slash + 1);
+}
+const char* kLineColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#7f7f7f"};
+}  // namespace
+
+std::vector<Figure> ladder_by_backbone_figures(const std::vector<eval::CellSummary>& cells) {
+  std::map<std::pair<std::string, std::string>, std::vector<const eval::CellSummary*>> by_cell;
+  for (const auto& c : cells)
+    if (!is_long_lag(c.key.split)) by_cell[{c.key.task, c.key.split}].push_back(&c);
+  std::vector<Figure> out;
+  for (const auto& [ts, cs] : by_cell) {
+    std::set<std::string> backbones;
+    std::set<std::string, decltype(&rung_less)> methods(&rung_less);
+    for (const auto* c : cs) {
+      backbones.insert(c->key.backbone);
+      methods.insert(c->key.method);
+    }
+    if (backbones.size() < 2 || methods.size() < 2) continue;
+    const std::vector<std::string> ms(methods.begin(), methods.end());
+    const double left = 64, top = 44, plot_h = 240, step = 62, legend_w = 300;
+    const double plot_w = std::max(240.0, step * static_cast<double>(ms.size()));
+    Svg svg(left + plot_w + legend_w, top + plot_h + 120);
+    svg.text(left, 24, "The ladder per backbone: " + ts.first + " / " + ts.second, "start", 14, " font-weight=\"bold\"");
+    success_axis(svg, left, top, plot_w, plot_h, "success (Wilson 95 %)");
+    const auto px = [&](std::size_t i) { return left + step * (static_cast<double>(i) + 0.5); };
+    const auto py = [&](double v) { return top + plot_h - std::clamp(v, 0.0, 1.0) * plot_h; };
+    for (std::size_t i = 0; i < ms.size(); ++i)
+      svg.text(px(i), top + plot_h + 14, ms[i], "end", 10, " transform=\"rotate(-35 " + num(px(i)) + " " + num(top + plot_h + 14) + ")\"");
+    std::size_t k = 0;
+    for (const auto& b : backbones) {
+      const std::string color = kLineColors[k % (sizeof kLineColors / sizeof *kLineColors)];
+      const double jitter = (static_cast<double>(k) - static_cast<double>(backbones.size() - 1) / 2.0) * 5.0;
+      std::string points;
+      for (std::size_t i = 0; i < ms.size(); ++i) {
+        const auto it = std::find_if(cs.begin(), cs.end(), [&](const auto* c) { return c->key.backbone == b && c->key.method == ms[i]; });
+        if (it == cs.end()) continue;
+        const auto& s = (*it)->success_once;
+        const double x = px(i) + jitter;
+        svg.line(x, py(s.lower), x, py(s.upper), color, 1.2);
+        svg.circle(x, py(s.rate), 3.5, color, backbone_label(b) + " " + ms[i] + ": " + rate3(s.rate) + " [" + rate3(s.lower) + ", " +
+                                                  rate3(s.upper) + "], n = " + std::to_string(s.total));
+        points += (points.empty() ? "" : " ") + num(x) + "," + num(py(s.rate));
+      }
+      svg.raw("<polyline points=\"" + points + "\" fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1.5\"/>\n");
+      const double ly = top + 6 + 18 * static_cast<double>(k);
+      svg.line(left + plot_w + 16, ly - 3, left + plot_w + 32, ly - 3, color, 2.5);
+      svg.text(left + plot_w + 38, ly + 1, backbone_label(b), "start", 11);
+      ++k;
+    }
+    out.push_back({"ladder_by_backbone_" + safe_name(ts.first) + "_" + safe_name(ts.second) + ".svg",
+                   "The ladder per backbone on " + ts.first + " / " + ts.second +
+                       ": success per method (rungs in the order of the paper's Fig. 4), one line per backbone",
+                   svg.str()});
+  }
+  return out;
+}
+
 std::optional<Figure> long_lag_figure(const std::vector<eval::CellSummary>& cells) {
   std::vector<eval::CellSummary> lag;
   for (const auto& c : cells)
@@ -347,6 +422,14 @@ std::vector<Figure> pareto_figures(const std::vector<eval::CellSummary>& cells) 
 std::vector<Figure> all_figures(const std::vector<eval::CellSummary>& cells, const nlohmann::json* gate1_verdict) {
   std::vector<Figure> out;
   if (auto g = gate1_figure(cells, gate1_verdict)) out.push_back(std::move(*g));
+  // results of several backbones in one cell: one ladder per cell with a line per backbone (the bar
+  // ladders and Pareto plots draw one backbone per cell)
+  auto by_backbone = ladder_by_backbone_figures(cells);
+  if (!by_backbone.empty()) {
+    for (auto& f : by_backbone) out.push_back(std::move(f));
+    if (auto l = long_lag_figure(cells)) out.push_back(std::move(*l));
+    return out;
+  }
   for (auto& f : ladder_figures(cells)) out.push_back(std::move(f));
   for (auto& f : pareto_figures(cells)) out.push_back(std::move(f));
   if (auto l = long_lag_figure(cells)) out.push_back(std::move(*l));

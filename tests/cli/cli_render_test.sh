@@ -48,8 +48,26 @@ import glob, json, sys
 r = json.loads(open(sys.argv[1]).read())
 r.pop("rendered"); r.pop("clean")
 recs = [json.loads(l) for f in glob.glob(sys.argv[2] + "/*.jsonl") for l in open(f)]
-match = [x for x in recs if x["episode_index"] == 1]
+# --contract 1 --episode 0: contract 1's episode of block 0 (the block's order is seeded, not 0, 1)
+assert r["contract_index"] == 1 and r["episode_index"] in (0, 1), r
+match = [x for x in recs if x["episode_index"] == r["episode_index"]]
 assert len(match) == 1 and match[0] == r, (match, r)
+PY
+# --contract I --episode E is contract I's episode of block E, whose order is seeded: in block 1 of this
+# job contract 1 runs first (job episode 2), so E * contracts + I (episode 3, contract 0) was wrong
+run "$AS" run --task pick_cube --split reference_seen --episodes 4 --method oracle --threads 2 --progress off --out "$TMP/runs4"
+expect_rc 0 "run oracle, 4 episodes"
+run "$AS" render --task pick_cube --split reference_seen --episodes 4 --method oracle --contract 1 --episode 1 --size 64x48 \
+  --frame 0 --out "$TMP/ep4.png"
+expect_rc 0 "render contract 1, episode 1"
+printf '%s\n' "$OUT" > "$TMP/render4.json"
+python3 - "$TMP/render4.json" "$TMP/runs4" <<'PY' && ok || bad "render --contract 1 --episode 1 is not contract 1's episode of block 1"
+import glob, json, sys
+r = json.loads(open(sys.argv[1]).read())
+r.pop("rendered"); r.pop("clean")
+assert r["contract_index"] == 1 and r["episode_index"] in (2, 3), r
+recs = [json.loads(l) for f in glob.glob(sys.argv[2] + "/*.jsonl") for l in open(f)]
+assert [x for x in recs if x["episode_index"] == r["episode_index"]] == [r]
 PY
 [ "$(head -c 6 "$TMP/ep.gif")" = "GIF89a" ] && ok || bad "not a GIF"
 [ "$(stat -c %s "$TMP/ep.gif")" -gt 1000 ] && ok || bad "GIF too small"

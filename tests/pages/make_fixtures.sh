@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 AS="$(realpath "$1")"; shift
-PAGES="${*:-brittleness long_lag noise_sensitivity gate0 identifiers dualabi_pilot ladder}"
+PAGES="${*:-brittleness long_lag noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance}"
 D=tests/pages/data
 S=20260718
 N=4
@@ -21,6 +21,19 @@ for page in $PAGES; do
     for m in no_adapt oracle grammar_belief; do run --task pick_cube --split reference_seen --method "$m" --out "$D/$page/results"; done
     for m in entropy_probes 'entropy_probes{calibrated}' dualabi 'dualabi{calibrated}'; do
       run --task pick_cube --split reference_seen --method "$m" --pool reference9 --out "$D/$page/results"
+    done ;;
+  backbone_variance)
+    # three backbones of push_cube (the committed PPO and the two replicas), two seeds, every method of the pairs
+    for b in ppo mlp:configs/backbones/replicas/push_cube.ppo.seed20260801.asmlp mlp:configs/backbones/replicas/push_cube.ppo.seed20260802.asmlp; do
+      for seed in 20260718 20260719; do
+        for m in oracle no_adapt; do N=2 SEED=$seed run --task push_cube --split reference_seen --method "$m" --backbone "$b" --out "$D/$page/results"; done
+        for p in '{"probe":"none"}' '{"probe":"hold"}' '{"probe":"hold","gripper_channel":true}'; do
+          N=2 SEED=$seed run --task push_cube --split reference_seen --method grammar_belief --params "$p" --backbone "$b" --out "$D/$page/results"
+        done
+        for m in exact_belief fixed_probes entropy_probes dualabi 'entropy_probes{calibrated}' 'dualabi{calibrated}'; do
+          N=2 SEED=$seed run --task push_cube --split reference_seen --method "$m" --pool reference9 --backbone "$b" --out "$D/$page/results"
+        done
+      done
     done ;;
   long_lag)
     for b in expert expert-delay-aware; do

@@ -4,7 +4,7 @@
 # scripts/ladder_groups.py, pairs from the fixture's ladder*.pairs).
 find_package(Python3 COMPONENTS Interpreter)
 if(Python3_Interpreter_FOUND)
-  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder)
+  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance)
     add_test(NAME pages.${page}
              COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/run_page_test.py ${page} $<TARGET_FILE:actionshift>)
     set_tests_properties(pages.${page} PROPERTIES LABELS pages TIMEOUT 120)

@@ -31,6 +31,10 @@ def page_text(page, binary, tmp):
         compare(binary, [f"{d}/results"], f"{tmp}/c.json", "scripts/brittleness.pairs")
         return py("scripts/brittleness_report.py", f"{tmp}/c.json", f"{d}/results", *PROV,
                   "--command", f"THREADS=1 EPISODES=4 scripts/brittleness {d}/results")
+    if page == "backbone_variance":
+        compare(binary, [f"{d}/results"], f"{tmp}/c.json", "scripts/backbone_variance.pairs", ["--across-backbones"])
+        return py("scripts/backbone_variance_report.py", f"{tmp}/c.json", "--commit", "0000000", "--wall", "12",
+                  "--command", f"scripts/backbone_variance {d}/results")
     if page == "long_lag":
         compare(binary, [f"{d}/results"], f"{tmp}/c.json", f"{d}/pairs.txt")
         return py("scripts/long_lag_report.py", f"{tmp}/c.json", f"{d}/results", *PROV,

@@ -136,8 +136,9 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
   std::map<std::string, std::string> listed;
   for (std::string sha, file; sums >> sha >> file;) listed[file] = sha;
   int files = 0;
-  // the backbones themselves, and under stages/ the files a committed backbone was warm-started from
-  // (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs)
+  // the backbones themselves, under stages/ the files a committed backbone was warm-started from
+  // (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs),
+  // and under replicas/ the independently trained replicas (<task>.ppo.seed<S>.asmlp, `mlp:<path>`)
   const std::filesystem::path root = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
   for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
     const std::string name = entry.path().filename().string();
@@ -151,8 +152,8 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
     const auto dot = stem.find('.');
     ASSERT_NE(dot, std::string::npos) << name;
     const sim::TaskId task = sim::parse_task(stem.substr(0, dot));
-    if (rel != name) {  // a stage: loads as a weight file of its task
-      ASSERT_EQ(rel.rfind("stages/", 0), 0u) << rel;
+    if (rel != name) {  // a stage or a replica: loads as a weight file of its task
+      ASSERT_TRUE(rel.rfind("stages/", 0) == 0 || rel.rfind("replicas/", 0) == 0) << rel;
       EXPECT_EQ(policy::MlpPolicy::from_file(entry.path().string())->task(), task) << rel;
       continue;
     }

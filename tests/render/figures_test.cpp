@@ -172,5 +172,43 @@ TEST(Report, WritesHtmlAndMarkdownWhoseLinksAllExist) {
   fs::remove_all(root);
 }
 
+
+// several backbones in one cell: one ladder per (task, split), one line per backbone, rungs in the
+// order of the paper's Fig. 4; all_figures then draws these instead of the single-backbone bars
+TEST(Figures, LadderPerBackboneDrawsOneLinePerBackbone) {
+  std::vector<eval::EpisodeRecord> recs;
+  const std::vector<std::string> backbones = {"ppo", "mlp:configs/backbones/replicas/push_cube.ppo.seed1.asmlp"};
+  for (const auto& b : backbones)
+    for (const auto& [m, k] : std::vector<std::pair<std::string, int>>{{"oracle", 10}, {"no_adapt", 0}, {"entropy_probes", 8}, {"grammar_belief{probe=hold}", 5}}) {
+      auto c = cell("push_cube", "reference_seen", m, 10, k, 0);
+      for (auto& r : c) {
+        r.backbone = b;
+        r.method_variant = m;
+        r.method = m.substr(0, m.find('{'));
+      }
+      recs.insert(recs.end(), c.begin(), c.end());
+    }
+  const auto cells = eval::summarize_records(recs);
+  const auto figs = ladder_by_backbone_figures(cells);
+  ASSERT_EQ(figs.size(), 1u);
+  EXPECT_EQ(figs[0].name, "ladder_by_backbone_push_cube_reference_seen.svg");
+  EXPECT_EQ(count(figs[0].svg, "<polyline"), 2);
+  EXPECT_EQ(count(figs[0].svg, "<circle"), 8);
+  EXPECT_THAT(figs[0].svg, HasSubstr("push_cube.ppo.seed1.asmlp"));  // a weight file by its name
+  // rungs bottom to top: no_adapt, grammar, entropy, oracle
+  const auto at = [&](const std::string& t) { return figs[0].svg.find(">" + t + "</text>"); };
+  EXPECT_LT(at("no_adapt"), at("grammar_belief{probe=hold}"));
+  EXPECT_LT(at("grammar_belief{probe=hold}"), at("entropy_probes"));
+  EXPECT_LT(at("entropy_probes"), at("oracle"));
+  const auto all = all_figures(cells);
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const Figure& f) { return f.name.starts_with("ladder_by_backbone_"); }));
+  EXPECT_FALSE(std::any_of(all.begin(), all.end(), [](const Figure& f) { return f.name.starts_with("ladder_reference"); }));
+  // one backbone: no such figure
+  std::vector<eval::EpisodeRecord> one;
+  for (const auto& r : recs)
+    if (r.backbone == "ppo") one.push_back(r);
+  EXPECT_TRUE(ladder_by_backbone_figures(eval::summarize_records(one)).empty());
+}
+
 }  // namespace
 }  // namespace actionshift::render

@@ -42,7 +42,14 @@ std::vector<Figure> pareto_figures(const std::vector<eval::CellSummary>& cells);
 /// there are none.
 std::optional<Figure> long_lag_figure(const std::vector<eval::CellSummary>& cells);
 
-/// Every figure the cells support, in the order Gate 1, ladders, Pareto, long lag.
+/// The ladder per backbone (the paper's Fig. 4 for each of several backbones): per (task, split) that
+/// two or more backbones hold (not long lag), success_once with Wilson intervals per method in rung
+/// order (no adaptation, identifiers, grammar belief, pool belief, DualABI, oracle; variants after
+/// their base), one line per backbone on shared axes.
+std::vector<Figure> ladder_by_backbone_figures(const std::vector<eval::CellSummary>& cells);
+
+/// Every figure the cells support, in the order Gate 1, ladders, Pareto, long lag; where a cell holds
+/// several backbones, the ladders per backbone instead of the bar ladders and Pareto plots.
 std::vector<Figure> all_figures(const std::vector<eval::CellSummary>& cells, const nlohmann::json* gate1_verdict = nullptr);
 
 /// Display colour of a method (#rrggbb), the same in every figure.
