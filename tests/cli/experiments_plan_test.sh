@@ -7,6 +7,7 @@ AS=${1:?usage: experiments_plan_test.sh ACTIONSHIFT_BINARY SOURCE_DIR}
 SRC=${2:?}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
+cd "$SRC" || exit 1  # an experiment names weight files relative to the repository root (mlp:configs/...)
 fail=0
 count=0
 while IFS= read -r f; do
