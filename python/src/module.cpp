@@ -1481,6 +1481,11 @@ PYBIND11_MODULE(_native, m) {
     for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t));
     return out;
   });
+  m.def("_task_maniskill_ids", [] {  // (name, ManiSkill id) of every task, from its description
+    std::vector<std::pair<std::string, std::string>> out;
+    for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t), sim::task_description(t).maniskill_id);
+    return out;
+  });
   m.def("_bench_cpp_steps", &bench_cpp_steps, py::arg("task"), py::arg("actions"), py::arg("seed"),
         py::arg("profile") = "maniskill");
   m.def("_bench_policy_calls", &bench_policy_calls, py::arg("policy"), py::arg("command"), py::arg("task"),

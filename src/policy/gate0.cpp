@@ -31,7 +31,7 @@ Wilson wilson(std::int64_t s, std::int64_t n) {
   return actionshift::wilson_interval(s, n);
 }
 
-double gate0_floor(sim::TaskId task) { return task == sim::TaskId::kPegInsertionSide ? 0.2 : 0.5; }
+double gate0_floor(sim::TaskId task) { return sim::task_description(task).gate0_floor; }
 
 std::string_view gate0_rule_name(Gate0Rule rule) {
   return rule == Gate0Rule::kWilsonLower ? "wilson_lower" : "point_estimate";
