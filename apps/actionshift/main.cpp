@@ -69,11 +69,8 @@ const CLI::Validator kNotNan(
 // usage error, rather than by whichever layer first builds a model
 const CLI::Validator kProfile(
     [](std::string& s) -> std::string {
-      const auto names = sim::profile_names();
-      if (std::find(names.begin(), names.end(), s) != names.end()) return {};
-      std::string known;
-      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-      return "unknown fidelity profile " + quote_input(s) + " (known: " + known + ")";
+      if (kProfiles.find(s)) return {};
+      return "unknown fidelity profile " + quote_input(s) + " (valid: " + kProfiles.list() + ")";
     },
     "PROFILE");
 

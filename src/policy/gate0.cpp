@@ -2,6 +2,7 @@
 #include "actionshift/policy/gate0.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
 #include <algorithm>
@@ -93,7 +94,7 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
   v.flagged_unwrapped = count(unwrapped, flagged);
   v.flagged_identity = count(identity, flagged);
   v.passed = v.competence.passed && v.identity_parity.passed;
-  v.decision = v.passed ? "advance" : "exclude";
+  v.decision = verdict_name(v.passed ? Verdict::kAdvance : Verdict::kExclude);
   if (!v.competence.passed) v.reason = "competence: " + v.competence.reason;
   else if (!v.identity_parity.passed) v.reason = "identity parity: " + v.identity_parity.reason;
   return v;
@@ -137,7 +138,7 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
         {"seed", v.seed},
         {"profile", v.profile},
         {"episodes", v.episodes},
-        {"verdict", v.passed ? "pass" : "fail"},
+        {"verdict", verdict_name(v.passed ? Verdict::kPass : Verdict::kFail)},
         {"decision", v.decision},
         {"reason", v.reason},
         {"competence",

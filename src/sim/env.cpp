@@ -52,33 +52,35 @@ void write_pose(Eigen::VectorXd& obs, int offset, const Eigen::Isometry3d& t) {
 }  // namespace
 
 std::string_view safety_flag_name(SafetyFlag f) {
-  switch (f) {
-    case SafetyFlag::kNone: return "none";
-    case SafetyFlag::kBadActionShape: return "bad_action_shape";
-    case SafetyFlag::kNonfiniteAction: return "nonfinite_action";
-    case SafetyFlag::kActionOutOfRange: return "action_out_of_range";
-    case SafetyFlag::kWorkspaceViolation: return "workspace_violation";
-    case SafetyFlag::kNonfiniteState: return "nonfinite_state";
-    case SafetyFlag::kUnstableState: return "unstable_state";
-  }
-  return "unknown";
+  const std::string_view n = kSafetyFlags.name(f);
+  return n.empty() ? "unknown" : n;
+}
+
+SafetyFlag parse_safety_flag(std::string_view text, const std::string& source, const std::string& field) {
+  return kSafetyFlags.parse(text, source, field);
 }
 
 // ---- profiles
 
-std::vector<std::string> profile_names() { return {"maniskill", "ideal"}; }
+std::vector<std::string> profile_names() {
+  std::vector<std::string> out;
+  for (const auto& e : kProfiles.entries) out.emplace_back(e.name);
+  return out;
+}
 
 EnvConfig profile_config(std::string_view name) {
   EnvConfig c;
-  c.profile = std::string(name);
-  if (name == "maniskill") return c;  // the defaults
-  if (name == "ideal") {
-    c.ik.mode = IkMode::kConverged;
-    c.physics.arm_drive = ArmDrive::kVelocityServo;
-    c.physics.arm_joint_limits = false;  // the converged ik keeps its targets inside the limits
-    return c;
+  const Profile p = parse_profile(name, "", "profile");
+  c.profile = std::string(profile_name(p));
+  switch (p) {
+    case Profile::kManiskill: return c;  // the defaults
+    case Profile::kIdeal:
+      c.ik.mode = IkMode::kConverged;
+      c.physics.arm_drive = ArmDrive::kVelocityServo;
+      c.physics.arm_joint_limits = false;  // the converged ik keeps its targets inside the limits
+      return c;
   }
-  throw std::invalid_argument("unknown fidelity profile '" + std::string(name) + "' (known: maniskill, ideal)");
+  return c;
 }
 
 // ---- model
