@@ -251,13 +251,7 @@ void check_output_dir(const std::string& path, const std::string& option) {
   check_ancestors(p, path, option);
 }
 
-eval::ProgressMode parse_progress_mode(const std::string& text) {
-  if (text == "auto") return eval::ProgressMode::automatic;
-  if (text == "bar") return eval::ProgressMode::bar;
-  if (text == "lines") return eval::ProgressMode::lines;
-  if (text == "off") return eval::ProgressMode::off;
-  throw InputError("--progress", "", "expected auto, bar, lines or off (got \"" + text + "\")");
-}
+eval::ProgressMode parse_progress_mode(const std::string& text) { return eval::parse_progress_mode(text, "command line", "--progress"); }
 
 int run_summarize(const SummarizeOptions& o, std::ostream& out, std::ostream& err) {
   return guarded(err, [&] {

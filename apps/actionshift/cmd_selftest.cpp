@@ -80,7 +80,7 @@ selftest::TcpPose pose_from_obs(const Eigen::VectorXd& obs, const sim::Observati
 std::string run_sim(selftest::SelfTest& st, const Contract& hidden, const SelftestOptions& o,
                     const std::shared_ptr<const sim::EnvModel>& model, std::uint64_t seed) {
   sim::HiddenContractEnv env(model, hidden,
-                             o.frame_rotation == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp);
+                             parse_rotation_mode(o.frame_rotation, "", "--frame-rotation"));
   st.begin(pose_from_obs(env.reset(seed), env.layout()));
   while (auto raw = st.next_probe()) {
     const sim::StepResult& r = env.step(*raw);
@@ -181,9 +181,8 @@ int run(const SelftestOptions& o) {
   if (o.sim && !o.demo.empty()) throw InputError("", "--demo", "--demo is synthetic; use --hidden-contract with --sim");
   if (o.strategy != "fixed" && o.strategy != "entropy")
     throw InputError("", "--strategy", "must be fixed or entropy (got " + quote_input(o.strategy) + ")");
-  if (o.frame_rotation != "live" && o.frame_rotation != "identity")
-    throw InputError("", "--frame-rotation", "must be live or identity (got " + quote_input(o.frame_rotation) + ")");
-  if (!o.sim && o.frame_rotation != "live") throw InputError("", "--frame-rotation", "only applies with --sim");
+  const RotationMode rotation = parse_rotation_mode(o.frame_rotation, "", "--frame-rotation");
+  if (!o.sim && rotation != RotationMode::kLive) throw InputError("", "--frame-rotation", "only applies with --sim");
   if (!o.sim && !o.calibration.empty()) throw InputError("", "--calibration", "only applies with --sim");
   if (!o.sim && (!o.robot.urdf.empty() || !o.robot.packages.empty()))
     throw InputError("", "--robot", "only applies with --sim");
@@ -248,7 +247,7 @@ int run(const SelftestOptions& o) {
                                            " with --sim (got " + std::to_string(so.budget) + ")");
     const auto cal = load_calibration(o);
     so.model = cal.model();
-    so.frame_rotation = o.frame_rotation == "identity" ? selftest::FrameRotation::kIdentity : selftest::FrameRotation::kMeasured;
+    so.frame_rotation = parse_rotation_mode(o.frame_rotation, "", "--frame-rotation");
     so.gripper = selftest::GripperMap{sim::kFingerTargetOffset, sim::kFingerTargetGain};  // probes hold the fingers
     char ratio[96];
     if (so.misspec_ratio_absolute)

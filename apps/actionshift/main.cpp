@@ -69,11 +69,8 @@ const CLI::Validator kNotNan(
 // usage error, rather than by whichever layer first builds a model
 const CLI::Validator kProfile(
     [](std::string& s) -> std::string {
-      const auto names = sim::profile_names();
-      if (std::find(names.begin(), names.end(), s) != names.end()) return {};
-      std::string known;
-      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-      return "unknown fidelity profile " + quote_input(s) + " (known: " + known + ")";
+      if (kProfiles.find(s)) return {};
+      return "unknown fidelity profile " + quote_input(s) + " (valid: " + kProfiles.list() + ")";
     },
     "PROFILE");
 
@@ -203,8 +200,10 @@ int main(int argc, char** argv) {
   // the options that name one job: `run` and `render` share them, so a render reaches the run's job id
   std::string method_list;  // the registry's names, so the help cannot fall behind it
   for (const std::string& m : adapt::method_names()) method_list += (method_list.empty() ? "" : ", ") + m;
+  std::string task_list;  // the tasks' names, from their descriptions (sim/task.hpp)
+  for (const sim::TaskId t : sim::all_tasks()) task_list += (task_list.empty() ? "" : ", ") + std::string(sim::task_name(t));
   const auto add_job_options = [&](CLI::App* cmd, cli::CliJobOptions& j, bool required) {
-    auto* task = cmd->add_option("--task", j.request.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->check(kNotEmpty);
+    auto* task = cmd->add_option("--task", j.request.task, task_list)->check(kNotEmpty);
     auto* split = cmd->add_option("--split", j.request.split, "Split manifest: a built-in name (seen, reference_seen, ...) or a file")
                       ->check(kNotEmpty);
     auto* method = cmd->add_option("--method", j.request.method.name,
@@ -310,7 +309,7 @@ int main(int argc, char** argv) {
   auto* bench_env = bench->add_subcommand(
       "env", "Control steps per second of the Bullet environment (scripted grasp-and-lift, with contact),\n"
              "on one thread and on all threads");
-  bench_env->add_option("--task", bench_env_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")
+  bench_env->add_option("--task", bench_env_o.task, task_list)
       ->capture_default_str();
   bench_env->add_option("--profile", bench_env_o.profile, "Simulator fidelity profile: maniskill or ideal")->check(kProfile)->capture_default_str();
   bench_env->add_option("--steps", bench_env_o.steps, "Control steps per thread")->capture_default_str();
@@ -361,8 +360,7 @@ int main(int argc, char** argv) {
       "Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input. See docs/selftest.md.");
   st->footer("Exit codes: 0 PASS, 1 MISMATCH, 2 INCONCLUSIVE, 3 bad input or usage.");
   st->add_option("--task", st_o.task,
-                 "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side: the environment probed with\n"
-                 "--sim, the report's task otherwise")
+                 task_list + ": the environment probed with\n--sim, the report's task otherwise")
       ->capture_default_str();
   auto* st_demo = st->add_option("--demo", st_o.demo,
                                  "Synthetic demo wiring: identity, swapped-axes, sign-flip, miswired, scaled, reversed, lagged, unmodeled");
@@ -445,7 +443,7 @@ int main(int argc, char** argv) {
              "ManiSkill PPO baseline's where they transfer (docs/backbones.md, PPO). Deterministic given the seed,\n"
              "whatever the thread count. Writes the actor mean as configs/backbones/<task>.ppo.asmlp (backbone\n"
              "`ppo`; checkpointed after every evaluation) and a training curve, one JSON line per iteration.");
-  ppo->add_option("--task", ppo_o.task, "pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side")->required();
+  ppo->add_option("--task", ppo_o.task, task_list)->required();
   ppo->add_option("--profile", ppo_o.profile, "Simulator fidelity profile of the rollouts: maniskill or ideal")->check(kProfile)->capture_default_str();
   ppo->add_option("--seed", ppo_o.seed, "Seed (initialisation, episodes, exploration noise, minibatches)")->check(kSeed)->capture_default_str();
   ppo->add_option("--total-steps", ppo_o.total_steps, "Environment steps of the run")->capture_default_str();

@@ -118,13 +118,7 @@ except (ImportError, AttributeError):  # pragma: no cover - depends on the machi
 
 
 _EnvBase = _gym.Env if _gym is not None else object
-_TASK_IDS = {
-    "pick_cube": "PickCube-v1",
-    "push_cube": "PushCube-v1",
-    "pull_cube": "PullCube-v1",
-    "stack_cube": "StackCube-v1",
-    "peg_insertion_side": "PegInsertionSide-v1",
-}
+_TASK_IDS = dict(_native._task_maniskill_ids())  # task name -> ManiSkill id (sim/task.hpp)
 
 
 def _check_seed(seed, name="seed"):

@@ -380,11 +380,7 @@ py::array_t<std::uint8_t> image_out(const render::Image& im) {
   return out;
 }
 
-sim::FrameRotation parse_rotation(const std::string& r) {
-  if (r == "live") return sim::FrameRotation::kLiveTcp;
-  if (r == "identity") return sim::FrameRotation::kIdentity;
-  throw InputError("rotation", "", "expected 'live' or 'identity' (got '" + r + "')");
-}
+sim::FrameRotation parse_rotation(const std::string& r) { return parse_rotation_mode(r, "rotation", ""); }
 
 Manifest split_manifest(const std::string& name) {
   Manifest m = data::resolve_manifest(name);
@@ -1301,11 +1297,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   eval::RunOptions ro;
   ro.threads = workers;
   ro.out_dir = out;
-  if (progress == "off") ro.progress = eval::ProgressMode::off;
-  else if (progress == "lines") ro.progress = eval::ProgressMode::lines;
-  else if (progress == "bar") ro.progress = eval::ProgressMode::bar;
-  else if (progress == "auto") ro.progress = eval::ProgressMode::automatic;
-  else throw InputError("progress", "", "expected auto, bar, lines or off (got \"" + progress + "\")");
+  ro.progress = eval::parse_progress_mode(progress, "progress", "");
   // Ctrl-C: Python runs signal handlers only on the main thread, which waits inside run_job without
   // the GIL; the runner polls this hook there, so a KeyboardInterrupt stops the job (the finished
   // episodes are kept and the job resumes on the next call) and is raised here
@@ -1468,9 +1460,7 @@ class PySelfTest {
         throw py::type_error("misspec_ratio_absolute: expected a number or None");
       o.misspec_ratio_absolute = misspec_ratio_absolute.cast<double>();
     }
-    if (frame_rotation == "measured") o.frame_rotation = selftest::FrameRotation::kMeasured;
-    else if (frame_rotation == "identity") o.frame_rotation = selftest::FrameRotation::kIdentity;
-    else throw InputError("selftest options", "frame_rotation", "expected 'measured' or 'identity' (got '" + frame_rotation + "')");
+    o.frame_rotation = parse_rotation_mode(frame_rotation, "selftest options", "frame_rotation");
     if (!gripper.is_none()) {  // (offset, gain): the probes hold the fingers (selftest::Options::gripper)
       const auto g = to_vec<2>(gripper, "gripper");
       o.gripper = selftest::GripperMap{g[0], g[1]};
@@ -1746,6 +1736,11 @@ PYBIND11_MODULE(_native, m) {
     for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t));
     return out;
   });
+  m.def("_task_maniskill_ids", [] {  // (name, ManiSkill id) of every task, from its description
+    std::vector<std::pair<std::string, std::string>> out;
+    for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t), sim::task_description(t).maniskill_id);
+    return out;
+  });
   m.def("_bench_cpp_steps", &bench_cpp_steps, py::arg("task"), py::arg("actions"), py::arg("seed"),
         py::arg("profile") = "maniskill");
   m.def("_bench_policy_calls", &bench_policy_calls, py::arg("policy"), py::arg("command"), py::arg("task"),
@@ -1876,7 +1871,7 @@ PYBIND11_MODULE(_native, m) {
                     const std::string&, const std::string&, py::object, py::object>(),
            py::arg("expected") = py::none(), py::arg("pool") = py::none(), py::arg("model") = py::none(),
            py::arg("strategy") = "entropy", py::arg("budget") = 6, py::arg("amplitude") = 0.5,
-           py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "measured",
+           py::arg("confidence_floor") = 0.9, py::arg("misspec_ratio") = 4.0, py::arg("frame_rotation") = "live",
            py::arg("task") = "custom", py::arg("gripper") = py::none(), py::arg("misspec_ratio_absolute") = py::none())
       .def(py::init([](const py::args& args, const py::kwargs& kwargs) {
         const auto v = bind_call("SelfTest",
@@ -1888,7 +1883,7 @@ PYBIND11_MODULE(_native, m) {
                                   {"amplitude", "a number", &castable<double>, py::float_(0.5)},
                                   {"confidence_floor", "a number", &castable<double>, py::float_(0.9)},
                                   {"misspec_ratio", "a number", &castable<double>, py::float_(4.0)},
-                                  {"frame_rotation", "a str", &castable<std::string>, py::str("measured")},
+                                  {"frame_rotation", "a str", &castable<std::string>, py::str("live")},
                                   {"task", "a str", &castable<std::string>, py::str("custom")},
                                   {"gripper", "a gripper description", &castable<py::object>, py::none()},
                                   {"misspec_ratio_absolute", "a number or None", &castable<py::object>, py::none()}},

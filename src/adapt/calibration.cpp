@@ -5,6 +5,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
+#include "actionshift/core/vocabulary.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -172,7 +173,8 @@ ResponseCalibration ResponseCalibration::from_json(const std::string& text, cons
     if (c.fit.fit_r2[i] > 1.0) throw InputError(source, "fit_r2", "must be at most 1");
     if (std::abs(c.fit.alpha[i]) > 1e3) throw InputError(source, "alpha", "must be at most 1e3 in magnitude");
   }
-  if (c.rotation_mode != "live") throw InputError(source, "rotation_mode", "must be 'live' (got '" + c.rotation_mode + "')");
+  if (parse_rotation_mode(c.rotation_mode, source, "rotation_mode") != RotationMode::kLive)
+    throw InputError(source, "rotation_mode", "must be 'live' (got '" + c.rotation_mode + "')");
   return c;
 }
 

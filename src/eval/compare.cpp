@@ -2,6 +2,7 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/json_input.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/data/paper_numbers.hpp"
 #include "actionshift/eval/gates.hpp"
 #include "actionshift/eval/summary.hpp"
@@ -275,9 +276,9 @@ json cell_json(const CellSummary& c, const std::vector<EpisodeRecord>& records, 
 
 // the rule of gates.cpp's promotion_verdict that decided (its order: prune, safety, seeds, promote, reject)
 std::string deciding_rule(const PromotionVerdict& v) {
-  if (v.decision == "prune") return "one_seed_below_prune_floor";
-  if (v.decision == "extend_seeds") return "fewer_than_three_matched_seeds";
-  if (v.decision == "promote") return v.five_point_rule ? "five_point_gain" : "pareto_point";
+  if (v.decision == verdict_name(Verdict::kPrune)) return "one_seed_below_prune_floor";
+  if (v.decision == verdict_name(Verdict::kExtendSeeds)) return "fewer_than_three_matched_seeds";
+  if (v.decision == verdict_name(Verdict::kPromote)) return v.five_point_rule ? "five_point_gain" : "pareto_point";
   return v.safety_regression ? "safety_regression" : "no_five_point_gain_or_pareto_point";
 }
 

@@ -188,7 +188,7 @@ struct Context {
   int finger_start{-1};  // the finger channel's offset, when the calibration has one
   std::shared_ptr<const policy::Policy> prototype;
   nlohmann::json params;
-  sim::FrameRotation rotation{sim::FrameRotation::kLiveTcp};
+  sim::FrameRotation rotation{sim::FrameRotation::kLive};
   EpisodeHooks hooks;  // default: the runner's episodes, unobserved
 
   std::mutex mutex;
@@ -331,7 +331,7 @@ EpisodeFn build_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Pol
     ctx->model = sim::EnvModel::make(task, env_config(job));
   }
   ctx->slice = tcp_slice(ctx->model->layout());
-  ctx->rotation = job.rotation_mode == "identity" ? sim::FrameRotation::kIdentity : sim::FrameRotation::kLiveTcp;
+  ctx->rotation = parse_rotation_mode(job.rotation_mode, "job", "rotation_mode");
 
   // a split's identity is its content hash: the job's file when it names one, else the built-in name
   const std::string split_source = job.split.path.empty() ? job.split.name : job.split.path;

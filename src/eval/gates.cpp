@@ -1,6 +1,7 @@
 #include "actionshift/eval/gates.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/vocabulary.hpp"
 
 #include <nlohmann/json.hpp>
 #include <iomanip>
@@ -147,13 +148,13 @@ Gate1Report gate1(const std::vector<EpisodeRecord>& records, std::size_t samples
       all_three = all_three && c.three_seed_comparison;
       const std::string rates = "oracle " + fixed(c.oracle->rate, 4) + ", no_adapt " + fixed(c.no_adapt->rate, 4);
       if (!gated) {
-        c.verdict = "descriptive";
+        c.verdict = verdict_name(Verdict::kDescriptive);
         c.reason = rates + " (split '" + c.split + "' is not gated: only seen and unseen_composition are)";
       } else if (c.oracle->rate >= kGate1OracleMin && c.no_adapt->rate <= kGate1NoAdaptMax) {
-        c.verdict = "pass";
+        c.verdict = verdict_name(Verdict::kPass);
         c.reason = rates;
       } else {
-        c.verdict = "fail";
+        c.verdict = verdict_name(Verdict::kFail);
         if (c.oracle->rate < kGate1OracleMin) c.reason = "oracle " + fixed(c.oracle->rate, 4) + " below " + fixed(kGate1OracleMin, 4);
         if (c.no_adapt->rate > kGate1NoAdaptMax)
           c.reason += (c.reason.empty() ? "" : "; ") + std::string("no_adapt ") + fixed(c.no_adapt->rate, 4) + " above " +
@@ -161,12 +162,12 @@ Gate1Report gate1(const std::vector<EpisodeRecord>& records, std::size_t samples
       }
     } else {
       c.seeds = distinct_seeds(g.oracle.empty() ? g.no_adapt : g.oracle);
-      c.verdict = gated ? "incomplete" : "descriptive";
+      c.verdict = verdict_name(gated ? Verdict::kIncomplete : Verdict::kDescriptive);
       c.reason = std::string("no ") + (c.oracle ? "no_adapt" : "oracle") + " records";
     }
     if (gated) {
       any_gated = true;
-      gated_ok = gated_ok && c.verdict == "pass";
+      gated_ok = gated_ok && c.verdict == verdict_name(Verdict::kPass);
     }
     report.cells.push_back(std::move(c));
   }
@@ -220,14 +221,14 @@ std::string gate1_to_markdown(const Gate1Report& report) {
   }
   bool any_gated = false;
   for (const auto& c : report.cells) {
-    if (c.verdict == "pass") continue;
-    if (c.verdict != "descriptive") any_gated = true;
+    if (c.verdict == verdict_name(Verdict::kPass)) continue;
+    if (c.verdict != verdict_name(Verdict::kDescriptive)) any_gated = true;
     s << "\n- " << c.task << "/" << c.split << " is "
       << c.verdict << ": " << c.reason;
   }
-  for (const auto& c : report.cells) any_gated = any_gated || c.verdict == "pass";
+  for (const auto& c : report.cells) any_gated = any_gated || c.verdict == verdict_name(Verdict::kPass);
   bool listed = false;
-  for (const auto& c : report.cells) listed = listed || c.verdict != "pass";
+  for (const auto& c : report.cells) listed = listed || c.verdict != verdict_name(Verdict::kPass);
   if (listed) s << "\n";
   s << "\nclaim status: " << report.claim_status << "; gate 1 " << (report.passed ? "passed" : "not passed");
   if (!report.passed && !any_gated) s << " (no gated cell: Gate 1 needs oracle and no_adapt on seen or unseen_composition)";
@@ -270,24 +271,24 @@ PromotionVerdict promotion_verdict(const std::vector<EpisodeRecord>& candidate, 
   const std::string diff = fixed(v.difference.estimate, 4) + " [" + fixed(v.difference.lower, 4) + ", " +
                            fixed(v.difference.upper, 4) + "]";
   if (v.matched_seeds == 1 && v.candidate_rate < kPruneSuccessFloor) {
-    v.decision = "prune";
+    v.decision = verdict_name(Verdict::kPrune);
     v.reason = "one-seed success " + fixed(v.candidate_rate, 4) + " below " + fixed(kPruneSuccessFloor, 4) +
                "; a sub-0.3 one-seed result is never promoted";
   } else if (v.safety_regression) {
-    v.decision = "reject";
+    v.decision = verdict_name(Verdict::kReject);
     v.reason = "safety regression: flagged-episode rate " + fixed(v.candidate_flag_rate, 4) + " vs baseline " +
                fixed(v.baseline_flag_rate, 4);
   } else if (v.matched_seeds < 3) {
-    v.decision = "extend_seeds";
+    v.decision = verdict_name(Verdict::kExtendSeeds);
     v.reason = "superiority requires at least three matched seeds (have " + std::to_string(v.matched_seeds) +
                "); difference " + diff;
   } else if (v.five_point_rule || v.pareto_rule) {
-    v.decision = "promote";
+    v.decision = verdict_name(Verdict::kPromote);
     v.reason = v.five_point_rule ? "difference " + diff + " at least " + fixed(kPromotionMinGain, 4)
                                  : "Pareto point: probe steps " + fixed(v.candidate_probe_steps, 2) + " vs " +
                                        fixed(v.baseline_probe_steps, 2) + ", difference " + diff;
   } else {
-    v.decision = "reject";
+    v.decision = verdict_name(Verdict::kReject);
     const bool cheaper_tie = v.candidate_probe_steps < v.baseline_probe_steps && v.difference.estimate >= 0.0;
     v.reason = "difference " + diff + " below " + fixed(kPromotionMinGain, 4) +
                (cheaper_tie ? " and success " + fixed(v.candidate_rate, 4) + " below the Pareto floor " + fixed(kParetoSuccessFloor, 4)
@@ -319,9 +320,11 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
   auto check = [&](const json& j, const std::string& name) {
     if (!j.is_object() || !j.contains("gate") || !j["gate"].is_string() || !j.contains("cells") || !j["cells"].is_object())
       throw InputError(name, "cells", "not a verdict file (needs \"gate\" and a \"cells\" object)");
-    for (auto it = j["cells"].begin(); it != j["cells"].end(); ++it)
+    for (auto it = j["cells"].begin(); it != j["cells"].end(); ++it) {
       if (!it.value().is_object() || !it.value().contains("verdict") || !it.value()["verdict"].is_string())
         throw InputError(name, "cells." + it.key() + ".verdict", "missing verdict string");
+      (void)parse_verdict(it.value()["verdict"].get<std::string>(), name, "cells." + it.key() + ".verdict");
+    }
   };
   check(expected, source);
   check(actual, actual_source);
@@ -340,7 +343,7 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
     const bool present = ac.contains(c.cell);
     c.actual = present ? ac[c.cell]["verdict"].get<std::string>() : "missing";
     // a positive verdict (gate1 "pass", gate0 "advance", promotion "promote") that is lost regresses
-    const bool positive = c.expected == "pass" || c.expected == "advance" || c.expected == "promote";
+    const bool positive = is_positive(parse_verdict(c.expected));
     c.regression = positive && c.actual != c.expected;
     std::string reason = present && ac[c.cell].contains("reason") && ac[c.cell]["reason"].is_string()
                              ? ac[c.cell]["reason"].get<std::string>()
@@ -353,7 +356,7 @@ std::vector<VerdictChange> compare_verdicts(const nlohmann::json& expected, cons
       reason = "rests on " + std::to_string(*have) + " episodes, fewer than the expected verdict's " + std::to_string(*want) +
                (reason.empty() ? "" : "; " + reason);
     }
-    const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (c.actual == "pass" || c.actual == "advance" || c.actual == "promote" ? "improved" : "changed");
+    const char* tag = c.regression ? "REGRESSION" : c.expected == c.actual ? "ok" : (present && is_positive(parse_verdict(c.actual)) ? "improved" : "changed");
     c.line = std::string(tag) + " " + c.cell + ": expected " + c.expected + ", got " + c.actual +
              (reason.empty() ? "" : " (" + reason + ")");
     out.push_back(std::move(c));

@@ -99,12 +99,8 @@ void validate_job(const JobSpec& job, const std::string& src) {
   check_manifest_path(job.split.path, src, "split.path");
   if (job.pool) check_manifest_path(job.pool->path, src, "pool.path");
   if (job.calibration_sha256) check_hash(*job.calibration_sha256, src, "calibration_sha256");
-  bool mode_ok = false;
-  for (auto m : kRotationModes) mode_ok = mode_ok || job.rotation_mode == m;
-  if (!mode_ok) throw InputError(src, "rotation_mode", "expected \"live\" or \"identity\" (got " + quote_input(job.rotation_mode, '"') + ")");
-  bool profile_ok = false;
-  for (auto p : kProfiles) profile_ok = profile_ok || job.profile == p;
-  if (!profile_ok) throw InputError(src, "profile", "expected \"maniskill\" or \"ideal\" (got " + quote_input(job.profile, '"') + ")");
+  (void)parse_rotation_mode(job.rotation_mode, src, "rotation_mode");
+  (void)parse_profile(job.profile, src, "profile");
   if (job.episodes <= 0) throw InputError(src, "episodes", "must be > 0 (got " + std::to_string(job.episodes) + ")");
   // a billion episodes is days of a cluster; a larger count is a typo (or a saturated parse of one)
   if (job.episodes > kMaxJobEpisodes)

@@ -331,16 +331,11 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   check_job_count(ex);
   if (root["rotation_mode"]) {
     ex.rotation_mode = require_string(root["rotation_mode"], source, "rotation_mode");
-    if (ex.rotation_mode != "live" && ex.rotation_mode != "identity")
-      throw InputError(at_line(source, root["rotation_mode"]), "rotation_mode",
-                       "expected \"live\" or \"identity\" (got " + shown(ex.rotation_mode) + ")");
+    (void)parse_rotation_mode(ex.rotation_mode, at_line(source, root["rotation_mode"]), "rotation_mode");
   }
   if (root["profile"]) {
     ex.profile = require_string(root["profile"], source, "profile");
-    bool ok = false;
-    for (auto p : kProfiles) ok = ok || ex.profile == p;
-    if (!ok)
-      throw InputError(at_line(source, root["profile"]), "profile", "expected \"maniskill\" or \"ideal\" (got " + shown(ex.profile) + ")");
+    (void)parse_profile(ex.profile, at_line(source, root["profile"]), "profile");
   }
   return ex;
 }

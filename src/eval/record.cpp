@@ -1,5 +1,7 @@
 #include "actionshift/eval/record.hpp"
 
+#include "actionshift/sim/env.hpp"
+
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
@@ -80,6 +82,7 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
   } catch (const std::invalid_argument&) {
     throw InputError(src, "task", "not a task of this benchmark (got " + quote_input(r.task, '"') + ")");
   }
+  (void)parse_profile(r.profile, src, "profile");
   if (!detail::is_token(r.split)) throw InputError(src, "split", "expected a name of [a-z0-9_.-] (got " + quote_input(r.split, '"') + ")");
   // a user method in another process is named by its command, `external:<command>` (docs/methods.md)
   const bool external = r.method.starts_with("external:") && r.method.size() > 9 && r.method.size() <= 512 &&
@@ -111,7 +114,13 @@ void validate_record(const EpisodeRecord& r, const std::string& src) {
   if (!std::isfinite(r.obs_noise) || r.obs_noise < 0.0) throw InputError(src, "obs_noise", "must be finite and >= 0");
   std::set<std::string> seen;
   for (const auto& f : r.safety_flags) {
-    if (!detail::is_token(f)) throw InputError(src, "safety_flags", "expected names of [a-z0-9_.-] (got " + quote_input(f, '"') + ")");
+    const auto flag = sim::kSafetyFlags.find(f);  // the simulator's flags, "none" excepted: no flag fired is []
+    if (!flag || *flag == sim::SafetyFlag::kNone) {
+      std::string valid;
+      for (const auto& e : sim::kSafetyFlags.entries)
+        if (e.value != sim::SafetyFlag::kNone) valid += (valid.empty() ? "" : ", ") + std::string(e.name);
+      throw InputError(src, "safety_flags", "unknown safety flag " + quote_input(f) + " (valid: " + valid + ")");
+    }
     if (!seen.insert(f).second) throw InputError(src, "safety_flags", "duplicate flag " + quote_input(f, '"'));
   }
   if (r.backbone.empty()) throw InputError(src, "backbone", "must not be empty");

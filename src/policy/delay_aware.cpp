@@ -16,20 +16,13 @@ struct Offsets {
 };
 
 Offsets offsets(sim::TaskId task) {
-  const auto& l = sim::observation_layout(task);
+  const sim::TaskDescription& d = sim::task_description(task);
+  const auto& l = d.layout();
   Offsets o;
   o.tcp = l.at("tcp_pose").offset;
   o.qpos = l.at("qpos").offset;
-  switch (task) {
-    case sim::TaskId::kPickCube:
-      o.obj = l.at("obj_pose").offset;
-      o.grasped = l.at("is_grasped").offset;
-      break;
-    case sim::TaskId::kPushCube:
-    case sim::TaskId::kPullCube: o.obj = l.at("obj_pose").offset; break;
-    case sim::TaskId::kStackCube: o.obj = l.at("cubeA_pose").offset; break;
-    case sim::TaskId::kPegInsertionSide: o.obj = l.at("peg_pose").offset; break;
-  }
+  o.obj = l.at(d.roles.object).offset;
+  if (!d.roles.grasped.empty()) o.grasped = l.at(d.roles.grasped).offset;
   return o;
 }
 

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string_view>
+#include <vector>
 
 namespace actionshift::policy {
 namespace {
@@ -17,7 +19,7 @@ using detail::move_to;
 using detail::yaw_of;
 using sim::TaskId;
 
-constexpr double kCubeHalf = 0.02;  // [m] every cube task (facts section 1)
+constexpr double kCubeHalf = sim::kCubeHalfSize;  // [m] every cube task
 constexpr double kGraspYawTolerance = 0.4;               // [rad] closing on a cube this far off its faces still works
 constexpr double kRestYaw = 0.0;                         // hand yaw of the rest pose (pick, push, pull)
 constexpr double kStackRestYaw = std::numbers::pi / 2;  // stack: joint 7 = -pi/4 turns the hand a quarter
@@ -28,38 +30,27 @@ struct Fields {
 };
 
 Fields fields_of(TaskId task) {
-  const sim::ObservationLayout& l = sim::observation_layout(task);
+  const sim::TaskDescription& d = sim::task_description(task);
+  const sim::ObservationLayout& l = d.layout();
+  auto offset = [&](std::string_view name) { return name.empty() ? -1 : l.at(name).offset; };
   Fields f;
   f.qpos = l.at("qpos").offset;
   f.qvel = l.at("qvel").offset;
   f.tcp = l.at("tcp_pose").offset;
-  switch (task) {
-    case TaskId::kPickCube:
-      f.obj = l.at("obj_pose").offset;
-      f.goal = l.at("goal_pos").offset;
-      f.grasped = l.at("is_grasped").offset;
-      break;
-    case TaskId::kPushCube:
-    case TaskId::kPullCube:
-      f.obj = l.at("obj_pose").offset;
-      f.goal = l.at("goal_pos").offset;
-      break;
-    case TaskId::kStackCube:
-      f.obj = l.at("cubeA_pose").offset;
-      f.obj_b = l.at("cubeB_pose").offset;
-      break;
-    case TaskId::kPegInsertionSide:
-      f.obj = l.at("peg_pose").offset;
-      f.obj_b = l.at("box_hole_pose").offset;
-      break;
-  }
+  f.obj = offset(d.roles.object);
+  f.goal = offset(d.roles.goal);
+  f.grasped = offset(d.roles.grasped);
+  f.obj_b = offset(d.roles.object_b);
   return f;
 }
 
 const Fields& fields(TaskId task) {
-  static const Fields all[] = {fields_of(TaskId::kPickCube), fields_of(TaskId::kPushCube), fields_of(TaskId::kPullCube),
-                               fields_of(TaskId::kStackCube), fields_of(TaskId::kPegInsertionSide)};
-  return all[static_cast<int>(task)];
+  static const std::vector<Fields> all = [] {
+    std::vector<Fields> v;
+    for (TaskId t : sim::all_tasks()) v.push_back(fields_of(t));
+    return v;
+  }();
+  return all.at(static_cast<std::size_t>(task));
 }
 
 // finger opening [m]: 0.08 fully open, about 0.04 on a cube, about 0 closed on nothing
@@ -237,6 +228,25 @@ Action peg_action(const Eigen::Ref<const Eigen::VectorXd>& obs, const Fields& f)
   return move_to(tcp, head_target + tcp_minus_head, tcp_des, -1.0, 2.0, 0.5);
 }
 
+// the scripted expert of each task that has one
+struct ExpertEntry {
+  TaskId task;
+  Action (*act)(const Eigen::Ref<const Eigen::VectorXd>& obs, const Fields& f);
+};
+constexpr ExpertEntry kExperts[] = {
+    {TaskId::kPickCube, &pick_action},
+    {TaskId::kPushCube, [](const Eigen::Ref<const Eigen::VectorXd>& obs, const Fields& f) { return push_pull_action(obs, f, +1.0); }},
+    {TaskId::kPullCube, [](const Eigen::Ref<const Eigen::VectorXd>& obs, const Fields& f) { return push_pull_action(obs, f, -1.0); }},
+    {TaskId::kStackCube, &stack_action},
+    {TaskId::kPegInsertionSide, &peg_action},
+};
+
+const ExpertEntry& expert_of(TaskId task) {
+  for (const ExpertEntry& e : kExperts)
+    if (e.task == task) return e;
+  throw std::invalid_argument("no scripted expert for task " + std::string(sim::task_name(task)));
+}
+
 class ExpertPolicy final : public Policy {
  public:
   explicit ExpertPolicy(TaskId task) : task_(task), hash_(sha256_hex(expert_identity(task))) {}
@@ -260,17 +270,12 @@ std::string expert_identity(TaskId task) {
 
 Action expert_action(TaskId task, const Eigen::Ref<const Eigen::VectorXd>& obs) {
   check_observation(obs, task);
-  const Fields& f = fields(task);
-  switch (task) {
-    case TaskId::kPickCube: return pick_action(obs, f);
-    case TaskId::kPushCube: return push_pull_action(obs, f, +1.0);
-    case TaskId::kPullCube: return push_pull_action(obs, f, -1.0);
-    case TaskId::kStackCube: return stack_action(obs, f);
-    case TaskId::kPegInsertionSide: return peg_action(obs, f);
-  }
-  throw std::invalid_argument("expert_action: unknown task");
+  return expert_of(task).act(obs, fields(task));
 }
 
-std::unique_ptr<Policy> make_expert(TaskId task) { return std::make_unique<ExpertPolicy>(task); }
+std::unique_ptr<Policy> make_expert(TaskId task) {
+  (void)expert_of(task);  // a task without a scripted expert is refused here, not at its first step
+  return std::make_unique<ExpertPolicy>(task);
+}
 
 }  // namespace actionshift::policy

@@ -2,6 +2,7 @@
 #include "actionshift/policy/gate0.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
 
 #include <algorithm>
@@ -31,7 +32,7 @@ Wilson wilson(std::int64_t s, std::int64_t n) {
   return actionshift::wilson_interval(s, n);
 }
 
-double gate0_floor(sim::TaskId task) { return task == sim::TaskId::kPegInsertionSide ? 0.2 : 0.5; }
+double gate0_floor(sim::TaskId task) { return sim::task_description(task).gate0_floor; }
 
 std::string_view gate0_rule_name(Gate0Rule rule) {
   return rule == Gate0Rule::kWilsonLower ? "wilson_lower" : "point_estimate";
@@ -93,7 +94,7 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
   v.flagged_unwrapped = count(unwrapped, flagged);
   v.flagged_identity = count(identity, flagged);
   v.passed = v.competence.passed && v.identity_parity.passed;
-  v.decision = v.passed ? "advance" : "exclude";
+  v.decision = verdict_name(v.passed ? Verdict::kAdvance : Verdict::kExclude);
   if (!v.competence.passed) v.reason = "competence: " + v.competence.reason;
   else if (!v.identity_parity.passed) v.reason = "identity parity: " + v.identity_parity.reason;
   return v;
@@ -142,7 +143,7 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
         {"seed", v.seed},
         {"profile", v.profile},
         {"episodes", v.episodes},
-        {"verdict", v.passed ? "pass" : "fail"},
+        {"verdict", verdict_name(v.passed ? Verdict::kPass : Verdict::kFail)},
         {"decision", v.decision},
         {"reason", v.reason},
         {"competence",

@@ -47,9 +47,9 @@ Eigen::Vector3d Camera::project(const Eigen::Vector3d& p, int width, int height)
 
 Camera default_camera(sim::TaskId task) {
   Camera c;
-  if (task == sim::TaskId::kPegInsertionSide) {
-    c.eye = Eigen::Vector3d(0.5, -0.5, 0.8);
-    c.target = Eigen::Vector3d(0.05, -0.1, 0.4);
+  if (const auto& view = sim::task_description(task).camera) {
+    c.eye = view->eye;
+    c.target = view->target;
   }
   return c;
 }

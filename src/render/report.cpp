@@ -4,6 +4,7 @@
 #include "xml_escape.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/eval/summary.hpp"
 #include "actionshift/render/figures.hpp"
 
@@ -191,7 +192,7 @@ ReportResult write_report(const std::string& results_dir, const std::string& out
       for (const auto& [cell, c] : v.doc["cells"].items()) {
         const std::string verdict = str_field(c, "verdict", str_field(c, "decision"));
         const std::string reason = str_field(c, "reason", "");
-        h << "<tr><td>" << esc(cell) << "</td><td class=\"" << (verdict == "pass" || verdict == "promote" ? "pass" : "")
+        h << "<tr><td>" << esc(cell) << "</td><td class=\"" << (verdict == verdict_name(Verdict::kPass) || verdict == verdict_name(Verdict::kPromote) ? "pass" : "")
           << "\">" << esc(verdict) << "</td><td>" << esc(reason) << "</td></tr>\n";
         m << "| " << md(cell) << " | " << md(verdict) << " | " << md(reason) << " |\n";
       }

@@ -44,21 +44,6 @@ struct EnvImpl {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kCubeHalf = 0.02;
-constexpr double kDensity = 1000.0;  // sapien default [kg/m^3]
-
-Eigen::Quaterniond yaw_quat(double yaw) { return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())); }
-
-detail::ObjectSpec cube_spec(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  detail::ObjectSpec s;
-  s.boxes.push_back({Eigen::Vector3d::Constant(kCubeHalf), Eigen::Isometry3d::Identity()});
-  s.mass = kDensity * 8.0 * kCubeHalf * kCubeHalf * kCubeHalf;
-  s.position = p;
-  s.orientation = q;
-  return s;
-}
-
 void write_pose(Eigen::VectorXd& obs, int offset, const Eigen::Isometry3d& t) {
   obs.segment<3>(offset) = t.translation();
   obs.segment<4>(offset + 3) = matrix_to_quat_wxyz(t.linear());
@@ -67,33 +52,35 @@ void write_pose(Eigen::VectorXd& obs, int offset, const Eigen::Isometry3d& t) {
 }  // namespace
 
 std::string_view safety_flag_name(SafetyFlag f) {
-  switch (f) {
-    case SafetyFlag::kNone: return "none";
-    case SafetyFlag::kBadActionShape: return "bad_action_shape";
-    case SafetyFlag::kNonfiniteAction: return "nonfinite_action";
-    case SafetyFlag::kActionOutOfRange: return "action_out_of_range";
-    case SafetyFlag::kWorkspaceViolation: return "workspace_violation";
-    case SafetyFlag::kNonfiniteState: return "nonfinite_state";
-    case SafetyFlag::kUnstableState: return "unstable_state";
-  }
-  return "unknown";
+  const std::string_view n = kSafetyFlags.name(f);
+  return n.empty() ? "unknown" : n;
+}
+
+SafetyFlag parse_safety_flag(std::string_view text, const std::string& source, const std::string& field) {
+  return kSafetyFlags.parse(text, source, field);
 }
 
 // ---- profiles
 
-std::vector<std::string> profile_names() { return {"maniskill", "ideal"}; }
+std::vector<std::string> profile_names() {
+  std::vector<std::string> out;
+  for (const auto& e : kProfiles.entries) out.emplace_back(e.name);
+  return out;
+}
 
 EnvConfig profile_config(std::string_view name) {
   EnvConfig c;
-  c.profile = std::string(name);
-  if (name == "maniskill") return c;  // the defaults
-  if (name == "ideal") {
-    c.ik.mode = IkMode::kConverged;
-    c.physics.arm_drive = ArmDrive::kVelocityServo;
-    c.physics.arm_joint_limits = false;  // the converged ik keeps its targets inside the limits
-    return c;
+  const Profile p = parse_profile(name, "", "profile");
+  c.profile = std::string(profile_name(p));
+  switch (p) {
+    case Profile::kManiskill: return c;  // the defaults
+    case Profile::kIdeal:
+      c.ik.mode = IkMode::kConverged;
+      c.physics.arm_drive = ArmDrive::kVelocityServo;
+      c.physics.arm_joint_limits = false;  // the converged ik keeps its targets inside the limits
+      return c;
   }
-  throw std::invalid_argument("unknown fidelity profile '" + std::string(name) + "' (known: maniskill, ideal)");
+  return c;
 }
 
 // ---- model
@@ -122,7 +109,8 @@ std::shared_ptr<const EnvModel> EnvModel::make(TaskId task, const EnvConfig& con
 }
 
 Eigen::Matrix<double, 9, 1> EnvModel::rest_qpos() const {
-  const double j7 = (task_ == TaskId::kStackCube || task_ == TaskId::kPegInsertionSide) ? -kPi / 4 : kPi / 4;
+  constexpr double kPi = std::numbers::pi;
+  const double j7 = task_description(task_).rest_wrist;
   Eigen::Matrix<double, 9, 1> q;
   q << 0.0, kPi / 8, 0.0, -5 * kPi / 8, 0.0, 3 * kPi / 4, j7, 0.04, 0.04;
   return q;
@@ -223,43 +211,13 @@ TaskSnapshot Env::snapshot() const {
 namespace {
 
 // observation vector of a snapshot, in the task's layout
-void compose_obs(TaskId task, const TaskSnapshot& s, const detail::EnvImpl& e, Eigen::VectorXd& obs) {
+void compose_obs(TaskId task, const TaskSnapshot& s, Eigen::VectorXd& obs) {
   const ObservationLayout& l = observation_layout(task);
   obs.resize(l.size());
   obs.segment<9>(l.at("qpos").offset) = s.qpos;
   obs.segment<9>(l.at("qvel").offset) = s.qvel;
   write_pose(obs, l.at("tcp_pose").offset, s.tcp);
-  const Eigen::Vector3d tcp = s.tcp.translation();
-  switch (task) {
-    case TaskId::kPickCube:
-      obs(l.at("is_grasped").offset) = s.grasped ? 1.0 : 0.0;
-      obs.segment<3>(l.at("goal_pos").offset) = s.goal;
-      write_pose(obs, l.at("obj_pose").offset, s.obj[0]);
-      obs.segment<3>(l.at("tcp_to_obj_pos").offset) = s.obj[0].translation() - tcp;
-      obs.segment<3>(l.at("obj_to_goal_pos").offset) = s.goal - s.obj[0].translation();
-      break;
-    case TaskId::kPushCube:
-    case TaskId::kPullCube:
-      obs.segment<3>(l.at("goal_pos").offset) = s.goal;
-      write_pose(obs, l.at("obj_pose").offset, s.obj[0]);
-      break;
-    case TaskId::kStackCube:
-      write_pose(obs, l.at("cubeA_pose").offset, s.obj[0]);
-      write_pose(obs, l.at("cubeB_pose").offset, s.obj[1]);
-      obs.segment<3>(l.at("tcp_to_cubeA_pos").offset) = s.obj[0].translation() - tcp;
-      obs.segment<3>(l.at("tcp_to_cubeB_pos").offset) = s.obj[1].translation() - tcp;
-      obs.segment<3>(l.at("cubeA_to_cubeB_pos").offset) = s.obj[1].translation() - s.obj[0].translation();
-      break;
-    case TaskId::kPegInsertionSide: {
-      write_pose(obs, l.at("peg_pose").offset, s.obj[0]);
-      obs.segment<3>(l.at("peg_half_size").offset) = Eigen::Vector3d(e.peg_half_length, e.peg_half_width, e.peg_half_width);
-      Eigen::Isometry3d hole = s.obj[1];
-      hole.translate(e.hole_offset);
-      write_pose(obs, l.at("box_hole_pose").offset, hole);
-      obs(l.at("box_hole_radius").offset) = e.hole_half_width;
-      break;
-    }
-  }
+  task_description(task).observe(s, l, obs);
 }
 
 bool finite_snapshot(const TaskSnapshot& s) {
@@ -293,87 +251,27 @@ const Eigen::VectorXd& Env::reset(std::uint64_t seed) {
   q9(7) = q9(8) = 0.04;
   // task objects (facts section 1)
   e.objects.clear();
-  e.goal.setZero();
-  e.peg_half_length = e.peg_half_width = e.hole_half_width = 0.0;
-  e.hole_offset.setZero();
-  switch (m.task()) {
-    case TaskId::kPickCube: {
-      const double x = rng.uniform(-0.1, 0.1), y = rng.uniform(-0.1, 0.1);
-      const double yaw = rng.uniform(0.0, 2 * kPi);
-      e.objects.push_back(cube_spec(Eigen::Vector3d(x, y, kCubeHalf), yaw_quat(yaw)));
-      const double gx = rng.uniform(-0.1, 0.1), gy = rng.uniform(-0.1, 0.1);
-      e.goal = Eigen::Vector3d(gx, gy, kCubeHalf + rng.uniform(0.0, 0.3));
-      break;
+  TaskEpisode episode;
+  task_description(m.task()).spawn(rng, episode);
+  for (const TaskObject& o : episode.objects) {
+    detail::ObjectSpec spec;
+    for (const TaskBox& b : o.boxes) {
+      detail::BoxPart part;
+      part.half_extents = b.half_extents;
+      part.pose = Eigen::Isometry3d::Identity();
+      part.pose.translation() = b.offset;
+      spec.boxes.push_back(part);
     }
-    case TaskId::kPushCube:
-    case TaskId::kPullCube: {
-      const double x = rng.uniform(-0.1, 0.1), y = rng.uniform(-0.1, 0.1);
-      e.objects.push_back(cube_spec(Eigen::Vector3d(x, y, kCubeHalf), Eigen::Quaterniond::Identity()));
-      const double dx = m.task() == TaskId::kPushCube ? 0.2 : -0.2;
-      e.goal = Eigen::Vector3d(x + dx, y, 1e-3);
-      break;
-    }
-    case TaskId::kStackCube: {
-      const double ox = rng.uniform(-0.1, 0.1), oy = rng.uniform(-0.1, 0.1);
-      const double ax = rng.uniform(-0.1, 0.1), ay = rng.uniform(-0.2, 0.2);
-      const double min_sep = 2.0 * (std::sqrt(2.0) * kCubeHalf + 0.001);
-      double bx = 0.0, by = 0.0;
-      bool placed = false;
-      for (int tries = 0; tries < 100 && !placed; ++tries) {
-        bx = rng.uniform(-0.1, 0.1);
-        by = rng.uniform(-0.2, 0.2);
-        placed = std::hypot(bx - ax, by - ay) > min_sep;
-      }
-      if (!placed) bx = by = 0.0;  // ManiSkill's sampler quirk
-      const double yaw_a = rng.uniform(0.0, 2 * kPi), yaw_b = rng.uniform(0.0, 2 * kPi);
-      e.objects.push_back(cube_spec(Eigen::Vector3d(ox + ax, oy + ay, kCubeHalf), yaw_quat(yaw_a)));
-      e.objects.push_back(cube_spec(Eigen::Vector3d(ox + bx, oy + by, kCubeHalf), yaw_quat(yaw_b)));
-      break;
-    }
-    case TaskId::kPegInsertionSide: {
-      const double L = rng.uniform(0.085, 0.125);
-      const double r = rng.uniform(0.015, 0.025);
-      const double clearance = 0.003;
-      const double cy = 0.5 * (L - r) * rng.uniform(-1.0, 1.0);
-      const double cz = 0.5 * (L - r) * rng.uniform(-1.0, 1.0);
-      e.peg_half_length = L;
-      e.peg_half_width = r;
-      e.hole_half_width = r + clearance;
-      e.hole_offset = Eigen::Vector3d(0.0, cy, cz);
-      const double px = rng.uniform(-0.1, 0.1), py = rng.uniform(-0.3, 0.0);
-      const double pyaw = rng.uniform(kPi / 2 - kPi / 3, kPi / 2 + kPi / 3);
-      const double bx = rng.uniform(-0.05, 0.05), by = rng.uniform(0.2, 0.4);
-      const double byaw = rng.uniform(kPi / 2 - kPi / 8, kPi / 2 + kPi / 8);
-      detail::ObjectSpec peg;
-      peg.boxes.push_back({Eigen::Vector3d(L, r, r), Eigen::Isometry3d::Identity()});
-      peg.mass = kDensity * 8.0 * L * r * r;
-      peg.position = Eigen::Vector3d(px, py, r);
-      peg.orientation = yaw_quat(pyaw);
-      e.objects.push_back(peg);
-      // box with a hole along its x axis: four static boxes (ManiSkill's _build_box_with_hole)
-      detail::ObjectSpec box;
-      const double inner = r + clearance, outer = L, depth = L;
-      const double thick = 0.5 * (outer - inner);
-      const double h0 = 0.5 * cy, h1 = 0.5 * cz;
-      const double off = thick + inner;
-      auto part = [](double hx, double hy, double hz, double x, double y, double z) {
-        detail::BoxPart p;
-        p.half_extents = Eigen::Vector3d(hx, hy, hz);
-        p.pose = Eigen::Isometry3d::Identity();
-        p.pose.translation() = Eigen::Vector3d(x, y, z);
-        return p;
-      };
-      box.boxes.push_back(part(depth, thick - h0, outer, 0, off + h0, 0));
-      box.boxes.push_back(part(depth, thick + h0, outer, 0, -off + h0, 0));
-      box.boxes.push_back(part(depth, outer, thick - h1, 0, 0, off + h1));
-      box.boxes.push_back(part(depth, outer, thick + h1, 0, 0, -off + h1));
-      box.mass = 0.0;
-      box.position = Eigen::Vector3d(bx, by, L);
-      box.orientation = yaw_quat(byaw);
-      e.objects.push_back(box);
-      break;
-    }
+    spec.mass = o.mass;
+    spec.position = o.position;
+    spec.orientation = o.orientation;
+    e.objects.push_back(std::move(spec));
   }
+  e.goal = episode.goal;
+  e.peg_half_length = episode.peg_half_length;
+  e.peg_half_width = episode.peg_half_width;
+  e.hole_half_width = episode.hole_half_width;
+  e.hole_offset = episode.hole_offset;
   // fresh physics world at the sampled state
   const int nb = e.world->num_dofs();
   Eigen::VectorXd qb = Eigen::VectorXd::Zero(nb);
@@ -387,7 +285,7 @@ const Eigen::VectorXd& Env::reset(std::uint64_t seed) {
   e.started = true;
   e.last = StepResult{};
   const TaskSnapshot s = snapshot();
-  compose_obs(m.task(), s, e, e.last.obs);
+  compose_obs(m.task(), s, e.last.obs);
   e.obs_noise = Rng(derive_seed({seed, detail::kObsNoiseStream}));
   detail::apply_obs_noise(m.layout(), m.config().obs_noise, e.obs_noise, e.last.obs);
   const TaskEvaluation ev = evaluate_task(m.task(), s);
@@ -442,7 +340,7 @@ const StepResult& Env::step(std::span<const double> a) {
     unstable = unstable || s.obj_linvel[i].norm() > m.config().max_object_speed;
   if (unstable) return end_with(SafetyFlag::kUnstableState);
 
-  compose_obs(m.task(), s, e, e.last.obs);
+  compose_obs(m.task(), s, e.last.obs);
   detail::apply_obs_noise(m.layout(), m.config().obs_noise, e.obs_noise, e.last.obs);
   const TaskEvaluation ev = evaluate_task(m.task(), s);
   e.last.success = ev.success;

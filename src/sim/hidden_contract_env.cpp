@@ -26,7 +26,7 @@ struct HiddenEnvImpl {
   bool started{false};  // a first reset has built the world
 
   Mat3 frame_rotation() const {
-    return rotation == FrameRotation::kLiveTcp ? Mat3(env.tcp_pose_in_base().linear()) : Mat3::Identity();
+    return rotation == FrameRotation::kLive ? Mat3(env.tcp_pose_in_base().linear()) : Mat3::Identity();
   }
 };
 }  // namespace detail

@@ -1,6 +1,8 @@
 // bullet world: the panda multibody built by hand from a RobotDescription, the table, task objects
 #include "physics_world.hpp"
 
+#include "actionshift/sim/task.hpp"
+
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
@@ -36,9 +38,6 @@ Eigen::Isometry3d eig(const btTransform& t) {
   return out;
 }
 
-// table of ManiSkill's TableSceneBuilder: top at z = 0
-constexpr double kTableHalfX = 0.6045, kTableHalfY = 1.209, kTableHalfZ = 0.45982;
-constexpr double kTableCenterX = -0.12;
 
 // collision groups
 constexpr int kGroupStatic = btBroadphaseProxy::StaticFilter;
@@ -192,7 +191,7 @@ PhysicsWorld::PhysicsWorld(const RobotDescription& desc, const ArticulationLayou
   };
   base_shape_ = build_compound(layout_.base);
   for (const auto& b : layout_.bodies) body_shapes_.push_back(build_compound(b));
-  table_shape_ = std::make_unique<btBoxShape>(btVector3(kTableHalfX, kTableHalfY, kTableHalfZ));
+  table_shape_ = std::make_unique<btBoxShape>(btVector3(kTable.half_x, kTable.half_y, kTable.half_z));
   q_target_ = Eigen::VectorXd::Zero(num_dofs());
   for (int i = 0; i < num_dofs(); ++i)
     if (!is_finger(i)) arm_dofs_.push_back(i);
@@ -252,7 +251,7 @@ void PhysicsWorld::rebuild(const std::vector<ObjectSpec>& objects, const Eigen::
   {
     btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, table_shape_.get());
     info.m_startWorldTransform.setIdentity();
-    info.m_startWorldTransform.setOrigin(btVector3(kTableCenterX, 0, -kTableHalfZ));
+    info.m_startWorldTransform.setOrigin(btVector3(kTable.center_x, 0, -kTable.half_z));
     info.m_friction = cfg_.default_friction;
     info.m_restitution = 0.0;
     table_ = std::make_unique<btRigidBody>(info);

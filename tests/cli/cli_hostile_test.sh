@@ -399,7 +399,7 @@ expect_err "its .jsonl file is empty (a job that stopped before its first episod
 # ---- --profile is checked while parsing: selftest had blamed a missing calibration, bench env printed no option
 run "$AS" bench env --task pick_cube --steps 5 --profile bogus
 expect_rc 2 "bench env --profile bogus"
-expect_err "--profile: unknown fidelity profile 'bogus' (known: maniskill, ideal)" "bench env --profile bogus"
+expect_err "--profile: unknown fidelity profile 'bogus' (valid: maniskill, ideal)" "bench env --profile bogus"
 run "$AS" selftest --sim --task pick_cube --hidden-contract identity --profile bogus
 expect_rc 3 "selftest --profile bogus"
 expect_err "unknown fidelity profile 'bogus'" "selftest --profile bogus"

@@ -104,4 +104,13 @@ one 2 "calibrate --steps -5" "--steps: " "-5"
 # 13. a missing contract file: was "cannot open file"
 run "$AS" contract hash "$TMP/missing.json"
 one 2 "contract hash MISSING" "$TMP/missing.json: no such file (expected a contract input file)"
+
+# 14. a record naming a safety flag the simulator does not have (a renamed flag): was accepted as any
+#     [a-z0-9_.-] name and counted as a flag of its own
+"$AS" run --task pick_cube --split reference_seen --method oracle --episodes 2 --threads 1 --progress off --out "$TMP/flags" > /dev/null 2>&1
+rec=$(ls "$TMP"/flags/*.jsonl)
+rm -f "$TMP"/flags/*.summary.json
+sed -i '2s/"safety_flags":\[\]/"safety_flags":["workspace_exit"]/' "$rec"
+run "$AS" summarize "$TMP/flags"
+one 2 "summarize with an unknown safety flag" "$rec:2: safety_flags: unknown safety flag 'workspace_exit' (valid: "
 finish

@@ -186,7 +186,7 @@ TEST_F(CmdEvalTest, PlanWritesPlanAndSlurmScriptThenRunsJobs) {
   std::ostringstream e4;
   EXPECT_EQ(run_plan(p, resolver, out, e4), 2);
   EXPECT_THAT(e4.str(), HasSubstr("smoke.yaml: splits: missing required key"));
-  EXPECT_THAT([] { parse_progress_mode("fancy"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("auto, bar, lines or off")));
+  EXPECT_THAT([] { parse_progress_mode("fancy"); }, ::testing::ThrowsMessage<InputError>(HasSubstr("--progress: unknown progress mode 'fancy' (valid: auto, bar, lines, off)")));
 }
 
 TEST_F(CmdEvalTest, CommittedExperimentsParse) {

@@ -40,7 +40,7 @@ inline EpisodeFn fake_episode_fn(int success_percent = 70, int sleep_ms = 0) {
     r.steps = 50;
     r.probe_steps = static_cast<std::int64_t>((h >> 32) % 7);
     r.probe_displacement = static_cast<double>((h >> 40) % 1000) * 1e-4;
-    if ((h >> 20) % 23 == 0) r.safety_flags = {"workspace_exit"};
+    if ((h >> 20) % 23 == 0) r.safety_flags = {"workspace_violation"};
     return r;
   };
 }

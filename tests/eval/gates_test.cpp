@@ -246,7 +246,7 @@ TEST(VerdictFiles, AVerdictOnFewerEpisodesThanExpectedIsARegression) {
 TEST(Promotion, SafetyRegressionBlocksPromotion) {
   auto cand = make_records("pick_cube", "seen", "c", kSeeds, 100, [](int k) { return k % 10 < 9; });
   const auto base = make_records("pick_cube", "seen", "b", kSeeds, 100, [](int k) { return k % 10 < 5; });
-  for (std::size_t i = 0; i < cand.size(); i += 20) cand[i].safety_flags = {"workspace_exit"};
+  for (std::size_t i = 0; i < cand.size(); i += 20) cand[i].safety_flags = {"workspace_violation"};
   const auto v = promotion_verdict(cand, base, 1000);
   EXPECT_TRUE(v.five_point_rule);
   EXPECT_TRUE(v.safety_regression);

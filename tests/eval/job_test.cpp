@@ -123,7 +123,7 @@ TEST(JobSpec, ValidationNamesTheField) {
   EXPECT_THAT([&] { validate_job(bad([](JobSpec& j) { j.episodes = 0; }), "cli"); },
               ThrowsMessage<InputError>(HasSubstr("cli: episodes: must be > 0")));
   EXPECT_THAT([&] { validate_job(bad([](JobSpec& j) { j.rotation_mode = "real"; }), "cli"); },
-              ThrowsMessage<InputError>(HasSubstr("rotation_mode: expected \"live\" or \"identity\"")));
+              ThrowsMessage<InputError>(HasSubstr("cli: rotation_mode: unknown rotation mode 'real' (valid: live, identity)")));
   EXPECT_THAT([&] { validate_job(bad([](JobSpec& j) { j.method_params = "[1]"; }), "cli"); },
               ThrowsMessage<InputError>(HasSubstr("method.params: expected a JSON object")));
   EXPECT_THAT([&] { validate_job(bad([](JobSpec& j) { j.split.contracts = 0; }), "cli"); },

@@ -80,7 +80,7 @@ TEST(Experiment, ErrorsNameFileAndField) {
         "methods[0].params.budget: duplicate key");
   fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nbackbone: expert\n",
         "e.yaml: episodes: missing required key");
-  fails(base + "rotation_mode: real\n", "rotation_mode: expected \"live\" or \"identity\"");
+  fails(base + "rotation_mode: real\n", "rotation_mode: unknown rotation mode 'real' (valid: live, identity)");
   fails("name: x\ntasks: [pick_cube, pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
         "tasks[1]: duplicate entry");
   fails("name: x\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1, -2]\nepisodes: 4\nbackbone: expert\n",
@@ -103,7 +103,7 @@ TEST(Experiment, ErrorsNameFileAndField) {
         "e.yaml:4: malformed YAML: invalid unicode");  // yaml-cpp refuses the surrogate itself
   fails("name: \"a\\nb\"\ntasks: [pick_cube]\nsplits: [seen]\nmethods: [oracle]\nseeds: [1]\nepisodes: 4\nbackbone: expert\n",
         "name: expected a name of [a-z0-9_.-] (got \"a\\nb\")");
-  fails(base + "profile: \"" + std::string(300, 'p') + "\"\n", "(got \"pppppppppp");
+  fails(base + "profile: \"" + std::string(300, 'p') + "\"\n", "profile: unknown fidelity profile 'pppppppppp");
   try {
     parse_experiment(base + "profile: \"" + std::string(300, 'p') + "\"\n", "e.yaml");
   } catch (const InputError& e) {

@@ -1,4 +1,5 @@
 #include "actionshift/eval/record.hpp"
+#include "actionshift/sim/env.hpp"
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
@@ -33,7 +34,7 @@ EpisodeRecord sample_record() {
   r.steps = 50;
   r.probe_steps = 6;
   r.probe_displacement = 0.0125;
-  r.safety_flags = {"workspace_exit"};
+  r.safety_flags = {"workspace_violation"};
   r.backbone = "expert";
   r.backbone_sha256 = sha256_hex("expert");
   return r;
@@ -46,10 +47,34 @@ TEST(EpisodeRecord, SerialisesAsOneCanonicalLine) {
       "\",\"contract_index\":1,\"contract_sha256\":\"" + sha256_hex("contract") +
       "\",\"episode_index\":7,\"job_id\":\"" + sha256_hex("job") +
       "\",\"method\":\"oracle\",\"method_variant\":\"oracle\",\"probe_displacement\":0.0125,\"probe_steps\":6,\"profile\":\"maniskill\",\"return\":12.5,"
-      "\"safety_flags\":[\"workspace_exit\"],\"schema_version\":\"2.0\",\"seed\":20260718,\"split\":\"seen\","
+      "\"safety_flags\":[\"workspace_violation\"],\"schema_version\":\"2.0\",\"seed\":20260718,\"split\":\"seen\","
       "\"steps\":50,\"success_at_end\":false,\"success_once\":true,\"task\":\"pick_cube\"}";
   EXPECT_EQ(line, expected);
   EXPECT_EQ(line.find('\n'), std::string::npos);
+}
+
+TEST(EpisodeRecord, RefusesAFlagOrProfileTheSimulatorDoesNotKnow) {
+  // a renamed flag must not pass unnoticed: the name read is checked against sim::kSafetyFlags
+  std::string line = to_jsonl_line(sample_record());
+  const std::string real = "\"workspace_violation\"";
+  std::string bad = line;
+  bad.replace(bad.find(real), real.size(), "\"workspace_exit\"");
+  EXPECT_THAT([&] { (void)parse_record_line(bad, "results/j.jsonl:3"); },
+              ThrowsMessage<InputError>(HasSubstr("results/j.jsonl:3: safety_flags: unknown safety flag 'workspace_exit' (valid: ")));
+  bad = line;
+  bad.replace(bad.find(real), real.size(), "\"none\"");
+  EXPECT_THAT([&] { (void)parse_record_line(bad, "j.jsonl:1"); }, ThrowsMessage<InputError>(HasSubstr("j.jsonl:1: safety_flags: ")));
+  bad = line;
+  bad.replace(bad.find("\"maniskill\""), 11, "\"physx\"");
+  EXPECT_THAT([&] { (void)parse_record_line(bad, "j.jsonl:1"); },
+              ThrowsMessage<InputError>(HasSubstr("j.jsonl:1: profile: unknown fidelity profile 'physx'")));
+  // every flag the simulator can raise is accepted
+  for (const auto& e : sim::kSafetyFlags.entries) {
+    if (e.value == sim::SafetyFlag::kNone) continue;
+    auto r = sample_record();
+    r.safety_flags = {std::string(e.name)};
+    EXPECT_EQ(parse_record_line(to_jsonl_line(r), "j.jsonl:1"), r) << e.name;
+  }
 }
 
 TEST(EpisodeRecord, WholeNumberFloatsKeepTheirDecimalPoint) {
@@ -99,7 +124,7 @@ TEST(EpisodeRecord, ParseErrorsNameSourceLineAndField) {
   EXPECT_THAT([&] { parse_record_line(with("method_variant", "\"oracle_x\""), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("method_variant: must be the method's name")));
   EXPECT_NO_THROW(parse_record_line(with("method_variant", "\"oracle{x=1}\""), "r.jsonl:2"));
-  EXPECT_THAT([&] { parse_record_line(with("safety_flags", "[\"a\",\"a\"]"), "r.jsonl:2"); },
+  EXPECT_THAT([&] { parse_record_line(with("safety_flags", "[\"workspace_violation\",\"workspace_violation\"]"), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("safety_flags: duplicate flag")));
   EXPECT_THAT([&] { parse_record_line(with("probe_steps", "51"), "r.jsonl:2"); },
               ThrowsMessage<InputError>(HasSubstr("probe_steps: exceeds steps")));

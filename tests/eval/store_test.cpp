@@ -186,8 +186,8 @@ TEST_F(StoreTest, SummaryCountsAndIntervals) {
   recs[1].success_once = false;
   recs[2].success_once = true;
   recs[3].success_once = true;
-  recs[3].safety_flags = {"workspace_exit", "non_finite_action"};
-  recs[1].safety_flags = {"workspace_exit"};
+  recs[3].safety_flags = {"workspace_violation", "nonfinite_action"};
+  recs[1].safety_flags = {"workspace_violation"};
   recs[2].safety_flags = {};
   recs[0].safety_flags = {};
   const auto s = make_job_summary(job, recs, 4, 1.5, "stopped", std::string(64, 'a'));
@@ -196,8 +196,8 @@ TEST_F(StoreTest, SummaryCountsAndIntervals) {
   EXPECT_EQ(s["complete"], false);
   EXPECT_EQ(s["success_once"]["successes"], 3);
   EXPECT_EQ(s["success_once"]["lower"].get<double>(), wilson_interval(3, 4).lower);
-  EXPECT_EQ(s["safety_flag_counts"]["workspace_exit"], 2);
-  EXPECT_EQ(s["safety_flag_counts"]["non_finite_action"], 1);
+  EXPECT_EQ(s["safety_flag_counts"]["workspace_violation"], 2);
+  EXPECT_EQ(s["safety_flag_counts"]["nonfinite_action"], 1);
   EXPECT_EQ(s["episodes_with_safety_flags"], 2);
   EXPECT_EQ(s["per_contract"].size(), 3u);
   // episodes 0..2 are block 0 (each contract once), episode 3 opens block 1 with one contract

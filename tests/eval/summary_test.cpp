@@ -22,8 +22,8 @@ TEST(Summary, GroupsByCellWithPerSeedRatesAndFlags) {
   auto oracle = make_records("pick_cube", "seen", "oracle", {1, 2}, 10, [](int k) { return k != 3; });
   oracle[0].probe_steps = 4;
   oracle[0].probe_displacement = 0.02;
-  oracle[1].safety_flags = {"workspace_exit"};
-  oracle[12].safety_flags = {"workspace_exit", "non_finite_state"};
+  oracle[1].safety_flags = {"workspace_violation"};
+  oracle[12].safety_flags = {"workspace_violation", "nonfinite_state"};
   oracle[15].success_once = false;  // seed 2, k = 5
   const auto none = make_records("pick_cube", "seen", "no_adapt", {1}, 10, [](int) { return false; });
   const auto cells = summarize_records(concat(none, oracle));
@@ -41,8 +41,8 @@ TEST(Summary, GroupsByCellWithPerSeedRatesAndFlags) {
   EXPECT_DOUBLE_EQ(c.per_seed[1].rate, 0.8);
   EXPECT_DOUBLE_EQ(c.mean_probe_steps, 4.0 / 20);
   EXPECT_DOUBLE_EQ(c.mean_probe_displacement, 0.02 / 20);
-  EXPECT_EQ(c.safety_flags.at("workspace_exit"), 2);
-  EXPECT_EQ(c.safety_flags.at("non_finite_state"), 1);
+  EXPECT_EQ(c.safety_flags.at("workspace_violation"), 2);
+  EXPECT_EQ(c.safety_flags.at("nonfinite_state"), 1);
   EXPECT_EQ(c.episodes_with_safety_flags, 2);
   EXPECT_EQ(c.jobs.size(), 2u);
 
@@ -52,7 +52,7 @@ TEST(Summary, GroupsByCellWithPerSeedRatesAndFlags) {
   const std::string md = summary_to_markdown(cells);
   EXPECT_THAT(md, HasSubstr("| pick_cube | seen | oracle | expert | 20 | 0.850 | ["));
   EXPECT_THAT(md, HasSubstr("1: 0.900, 2: 0.800"));
-  EXPECT_THAT(md, HasSubstr("non_finite_state 1, workspace_exit 2"));
+  EXPECT_THAT(md, HasSubstr("nonfinite_state 1, workspace_violation 2"));
 }
 
 TEST(Summary, DuplicateEpisodesInACellAreAnError) {

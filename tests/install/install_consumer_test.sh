@@ -26,4 +26,18 @@ cmake --build "$WORK/method" > "$WORK/method-build.log" 2>&1 || { cat "$WORK/met
 out=$("$WORK/method/separation_example" "$WORK/method-results" 3) || { echo "method example failed: $out"; exit 1; }
 echo "$out"
 [ "$(wc -l < "$(awk '{print $2}' <<<"$out")")" = 3 ] || { echo "method example: expected 3 records"; exit 1; }
+# find_package(ActionShift COMPONENTS <c>) alone, for every component of the installed graph
+COMPONENTS_FILE="$WORK/prefix/lib/cmake/ActionShift/ActionShiftComponents.cmake"
+[ -f "$COMPONENTS_FILE" ] || COMPONENTS_FILE=$(find "$WORK/prefix" -name ActionShiftComponents.cmake | head -1)
+comps=$(sed -n 's/^set(ACTIONSHIFT_COMPONENTS \(.*\))$/\1/p' "$COMPONENTS_FILE")
+[ -n "$comps" ] || { echo "no component list in $COMPONENTS_FILE"; exit 1; }
+for c in $comps; do
+  cmake -S "$CONSUMER/../component" -B "$WORK/component-$c" -DCOMPONENT="$c" -DCMAKE_PREFIX_PATH="$WORK/prefix" \
+    -DCMAKE_BUILD_TYPE=Release > "$WORK/component-$c-configure.log" 2>&1 \
+    || { echo "find_package(ActionShift COMPONENTS $c) failed:"; cat "$WORK/component-$c-configure.log"; exit 1; }
+  cmake --build "$WORK/component-$c" > "$WORK/component-$c-build.log" 2>&1 \
+    || { echo "component $c: build failed:"; cat "$WORK/component-$c-build.log"; exit 1; }
+  "$WORK/component-$c/component" > /dev/null || { echo "component $c: the program failed"; exit 1; }
+  echo "component $c: find_package, link and run ok"
+done
 echo "install consumer: ok"

@@ -413,7 +413,7 @@ TEST(Unchecked, FrameIsCheckedUnderAMeasuredRotationFarFromIdentity) {
   // a robot whose tool points down (180° about x) and decodes tool-frame commands with its live
   // rotation; response = α ⊙ canonical, exactly, with small rotation gains
   Options o;
-  o.frame_rotation = FrameRotation::kMeasured;
+  o.frame_rotation = FrameRotation::kLive;
   o.model.alpha = {1, 1, 1, 0.1, 0.1, 0.1};
   o.model.sigma.fill(0.02);
   const Contract tool = reference::with(Contract::identity(), "delta", "tool", 0);
@@ -441,7 +441,7 @@ TEST(Unchecked, FrameIsCheckedUnderAMeasuredRotationFarFromIdentity) {
 
 TEST(Unchecked, FrameIsNotCheckedWhileTheMeasuredRotationStaysNearIdentity) {
   Options o;
-  o.frame_rotation = FrameRotation::kMeasured;
+  o.frame_rotation = FrameRotation::kLive;
   SelfTest st(o);
   SyntheticRobot robot(Contract::identity(), o.model, 1);  // starts at identity orientation
   run(st, robot);

@@ -85,7 +85,7 @@ TEST(HiddenContractEnv, OracleEncodeThenWrapperDecodeReproducesTheCanonicalActio
   const std::vector<Contract> contracts = reference_manifest_contracts();
   ASSERT_EQ(contracts.size(), 6u);
   const auto model = EnvModel::make(TaskId::kPickCube);
-  for (FrameRotation rot : {FrameRotation::kLiveTcp, FrameRotation::kIdentity}) {
+  for (FrameRotation rot : {FrameRotation::kLive, FrameRotation::kIdentity}) {
     for (std::size_t ci = 0; ci < contracts.size(); ++ci) {
       HiddenContractEnv env(model, contracts[ci], rot);
       const OracleRecorder oracle = eval::detail::OracleAccess::view(env);
@@ -132,7 +132,7 @@ TEST(HiddenContractEnv, IdentityContractMatchesTheUnwrappedEnvByteForByte) {
 TEST(HiddenContractEnv, ToolFrameUsesTheLiveTcpOrientationUnlessIdentityMode) {
   const Contract tool = with(Contract::identity(), "delta", "tool", 0);
   const auto model = EnvModel::make(TaskId::kPickCube);
-  HiddenContractEnv live(model, tool, FrameRotation::kLiveTcp), flat(model, tool, FrameRotation::kIdentity);
+  HiddenContractEnv live(model, tool, FrameRotation::kLive), flat(model, tool, FrameRotation::kIdentity);
   live.reset(2);
   flat.reset(2);
   const OracleRecorder ol = eval::detail::OracleAccess::view(live), of = eval::detail::OracleAccess::view(flat);

@@ -126,5 +126,44 @@ TEST(Tasks, GraspPredicateNeedsBothFingersPushedOutward) {
   EXPECT_FALSE(is_grasping(tilted, Eigen::Vector3d(0, 3, 0), y, 0.5, 20.0));
 }
 
+
+// every task's description is complete and consistent: the one place a task is defined
+TEST(TaskDescription, EveryTaskIsDescribedCompletely) {
+  for (const TaskId t : all_tasks()) {
+    const TaskDescription& d = task_description(t);
+    EXPECT_EQ(d.id, t);
+    EXPECT_EQ(parse_task(d.name), t);
+    EXPECT_EQ(task_name(t), d.name);
+    EXPECT_TRUE(d.maniskill_id.ends_with("-v1")) << d.name;
+    EXPECT_TRUE(d.maniskill_source.starts_with("mani_skill/envs/tasks/")) << d.name;
+    EXPECT_GT(d.horizon, 0);
+    EXPECT_EQ(task_horizon(t), d.horizon);
+    EXPECT_EQ(std::abs(d.rest_wrist), std::numbers::pi / 4);
+    EXPECT_GT(d.gate0_floor, 0.0);
+    ASSERT_TRUE(d.layout && d.spawn && d.observe && d.evaluate && d.draw) << d.name;
+    EXPECT_EQ(&observation_layout(t), &d.layout());
+    for (const char* common : {"qpos", "qvel", "tcp_pose"}) EXPECT_NE(d.layout().find(common), nullptr) << d.name << " " << common;
+    for (std::string_view role : {d.roles.object, d.roles.object_b, d.roles.goal, d.roles.grasped}) {
+      if (!role.empty()) {
+        EXPECT_NE(d.layout().find(role), nullptr) << d.name << " " << role;
+      }
+    }
+    EXPECT_FALSE(d.roles.object.empty()) << d.name;
+  }
+}
+
+TEST(TaskDescription, BoxWithHoleLeavesTheHoleOpen) {
+  // four walls around a square hole of half width w centred at (cy, cz): no wall reaches into it
+  const double L = 0.1, w = 0.023;
+  const Eigen::Vector3d hole(0.0, 0.01, -0.015);
+  for (const TaskBox& b : box_with_hole(L, w, hole)) {
+    EXPECT_GT(b.half_extents.minCoeff(), 0.0);
+    const Eigen::Vector3d lo = b.offset - b.half_extents, hi = b.offset + b.half_extents;
+    const bool clear_y = hi.y() <= hole.y() - w + 1e-12 || lo.y() >= hole.y() + w - 1e-12;
+    const bool clear_z = hi.z() <= hole.z() - w + 1e-12 || lo.z() >= hole.z() + w - 1e-12;
+    EXPECT_TRUE(clear_y || clear_z) << b.offset.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace actionshift::sim

@@ -6,6 +6,8 @@
 /// seed and episode count. Its id is the SHA-256 of its canonical JSON, and its results live in
 /// `<out>/<id>.jsonl` and `<out>/<id>.summary.json`.
 
+#include "actionshift/core/vocabulary.hpp"
+
 #include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
@@ -85,13 +87,6 @@ struct MethodPluginRef {
 /// "cannot read file") for an unreadable one and for an empty list.
 std::string files_content_sha256(const std::vector<std::string>& paths, const std::string& field = "--policy-files");
 
-/// Accepted values of JobSpec::rotation_mode.
-/// "live": tool frame = live TCP orientation (default, docs/semantics.md §4); "identity": R = I (the reference implementation's headline setting).
-inline constexpr std::string_view kRotationModes[] = {"live", "identity"};
-
-/// Accepted values of JobSpec::profile: the simulator fidelity profiles (sim::profile_names()).
-/// "maniskill" (default): ManiSkill's one-step IK and PD drives; "ideal": converged IK, first-order servo.
-inline constexpr std::string_view kProfiles[] = {"maniskill", "ideal"};
 
 /// Everything that determines a job's episodes. Equality of ids (not of structs) is identity:
 /// `method_params` is compared as text here but hashed in canonical form.
@@ -104,8 +99,8 @@ struct JobSpec {
   BackboneRef backbone;                      ///< frozen policy
   std::optional<PoolRef> pool;               ///< declared pool, or none
   std::optional<std::string> calibration_sha256;  ///< 64-hex calibration hash, or none
-  std::string rotation_mode{"live"};         ///< one of kRotationModes
-  std::string profile{"maniskill"};          ///< one of kProfiles: the simulator fidelity profile
+  std::string rotation_mode{"live"};         ///< a name of actionshift::kRotationModes (core/vocabulary.hpp)
+  std::string profile{"maniskill"};          ///< a name of actionshift::kProfiles: the simulator fidelity profile
   std::uint64_t seed{0};                     ///< experimental seed
   std::int64_t episodes{0};                  ///< number of episodes (> 0)
   std::optional<RobotRef> robot;             ///< robot description; none = the embedded Panda

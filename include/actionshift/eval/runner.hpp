@@ -3,6 +3,7 @@
 /// records in episode order, so the JSONL file is byte-identical for any thread count and after any
 /// number of kills and resumes.
 
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/record.hpp"
 
@@ -50,6 +51,16 @@ enum class ProgressMode {
   lines,      ///< a plain log line about every 5 s, and one at the end
   off,        ///< nothing
 };
+/// The names of the progress modes (CLI `--progress`, Python `evaluate(progress=...)`).
+inline constexpr auto kProgressModes = make_vocabulary<ProgressMode>(
+    "progress mode", Vocabulary<ProgressMode, 4>::Entry{ProgressMode::automatic, "auto"},
+    Vocabulary<ProgressMode, 4>::Entry{ProgressMode::bar, "bar"}, Vocabulary<ProgressMode, 4>::Entry{ProgressMode::lines, "lines"},
+    Vocabulary<ProgressMode, 4>::Entry{ProgressMode::off, "off"});
+inline std::string_view progress_mode_name(ProgressMode m) { return kProgressModes.name(m); }
+inline ProgressMode parse_progress_mode(std::string_view text, const std::string& source = "",
+                                        const std::string& field = "--progress") {
+  return kProgressModes.parse(text, source, field);
+}
 
 /// Options of run_job.
 struct RunOptions {

@@ -22,6 +22,7 @@
 #include "actionshift/adapt/response.hpp"
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/types.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/selftest/verdict.hpp"
 
 #include <Eigen/Core>
@@ -40,11 +41,10 @@ enum class Strategy {
 };
 const char* to_string(Strategy s);  ///< "fixed" or "entropy"
 
-/// Where the rotation used to decode `tool`-frame hypotheses comes from.
-enum class FrameRotation {
-  kMeasured,  ///< the measured TCP orientation before each probe (the robot's live tool frame)
-  kIdentity,  ///< R = I (the reference's headline setting): tool equals base, so frame is not checked
-};
+/// Where the rotation used to decode `tool`-frame hypotheses comes from: the rotation mode
+/// (core/vocabulary.hpp), kLive = the measured TCP orientation before each probe (the robot's live tool
+/// frame), kIdentity = R = I (the reference's headline setting: tool equals base, so frame is not checked).
+using FrameRotation = RotationMode;
 
 /// A measured TCP pose in the robot base frame.
 struct TcpPose {
@@ -76,7 +76,7 @@ struct Options {
   /// If set, the threshold when the MAP has absolute targets (an absolute command's response is not
   /// what the delta-command gain calibration describes, so its residuals run on another scale), > 0.
   std::optional<double> misspec_ratio_absolute;
-  FrameRotation frame_rotation{FrameRotation::kMeasured};  ///< rotation for tool-frame decoding
+  FrameRotation frame_rotation{FrameRotation::kLive};  ///< rotation for tool-frame decoding
   double min_frame_angle{0.2};      ///< [rad] frame is checked only if the TCP orientation stays at least this far from identity
   /// Entropy strategy: a channel whose commanded raw sum is non-zero may only be pulsed back towards
   /// zero, so the summed raw command of every channel stays within ±amplitude. Under any delta wiring

@@ -10,6 +10,7 @@
 ///   const auto& r = env.step(canonical_action);     // 7 numbers, docs/semantics.md §1
 /// \endcode
 
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/core/types.hpp"
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/physics_config.hpp"
@@ -43,8 +44,19 @@ enum class SafetyFlag : std::uint8_t {
   kNonfiniteState,       ///< "nonfinite_state": NaN or inf in the simulated state
   kUnstableState,        ///< "unstable_state": joint or object speeds beyond any physical motion
 };
+/// The flags' names, as written into episode records ("none" is never written).
+inline constexpr auto kSafetyFlags = make_vocabulary<SafetyFlag>(
+    "safety flag", Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kNone, "none"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kBadActionShape, "bad_action_shape"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kNonfiniteAction, "nonfinite_action"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kActionOutOfRange, "action_out_of_range"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kWorkspaceViolation, "workspace_violation"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kNonfiniteState, "nonfinite_state"},
+    Vocabulary<SafetyFlag, 7>::Entry{SafetyFlag::kUnstableState, "unstable_state"});
 /// Name of a flag, as written into episode records ("none", "nonfinite_action", ...).
 std::string_view safety_flag_name(SafetyFlag f);
+/// The flag named `text`; throws actionshift::InputError(source, field, "unknown safety flag ...") otherwise.
+SafetyFlag parse_safety_flag(std::string_view text, const std::string& source = "", const std::string& field = "safety_flags");
 
 /// Axis-aligned box (world frame) the TCP must stay inside.
 struct WorkspaceBox {
@@ -97,7 +109,7 @@ std::vector<std::string> profile_names();
 ///   inertia and the 100 N m force limit, joint limits enforced by the simulator;
 /// - "ideal": IK iterated to convergence within the joint limits and a first-order velocity servo,
 ///   the project's original, cleaner response.
-/// Throws std::invalid_argument naming the known profiles for any other name.
+/// Throws actionshift::InputError (a std::invalid_argument) naming the valid profiles for any other name.
 EnvConfig profile_config(std::string_view name);
 
 /// Immutable description of one task's environment, shared by every worker thread.

@@ -7,6 +7,7 @@
 
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/types.hpp"
+#include "actionshift/core/vocabulary.hpp"
 #include "actionshift/sim/env.hpp"
 
 #include <cstdint>
@@ -25,11 +26,9 @@ struct HiddenEnvImpl;
 }
 struct Scene;
 
-/// Which rotation the decoder's `tool` frame uses.
-enum class FrameRotation {
-  kLiveTcp,   ///< TCP orientation in the robot base frame, read before the step (default)
-  kIdentity,  ///< R = I: `tool` equals `base` (the reference's headline setting)
-};
+/// Which rotation the decoder's `tool` frame uses: the rotation mode (core/vocabulary.hpp), kLive = the
+/// TCP orientation in the robot base frame read before the step (default), kIdentity = R = I.
+using FrameRotation = RotationMode;
 
 /// Agent-facing environment under a hidden contract. Raw actions in (any length: a wrong length
 /// ends the episode with bad_action_shape), observations out. Deliberately has no accessor for the
@@ -37,7 +36,7 @@ enum class FrameRotation {
 class HiddenContractEnv {
  public:
   HiddenContractEnv(std::shared_ptr<const EnvModel> model, const Contract& contract,
-                    FrameRotation rotation = FrameRotation::kLiveTcp);
+                    FrameRotation rotation = FrameRotation::kLive);
   ~HiddenContractEnv();
   HiddenContractEnv(HiddenContractEnv&&) noexcept;
   HiddenContractEnv& operator=(HiddenContractEnv&&) noexcept;

@@ -49,8 +49,8 @@ inline const Eigen::Vector4f kCubeColor{0.85f, 0.08f, 0.08f, 1.0f};   ///< cube 
 inline const Eigen::Vector4f kCubeBColor{0.10f, 0.70f, 0.15f, 1.0f};  ///< stack_cube's cube B
 inline const Eigen::Vector4f kPegTailColor{0.15f, 0.25f, 0.85f, 1.0f};  ///< second half of the peg
 
-/// Half side of the task cubes [m] (ManiSkill: 0.02).
-inline constexpr double kSceneCubeHalf = 0.02;
+/// Half side of the task cubes [m]: sim::kCubeHalfSize (task.hpp), under the name renderers used first.
+inline constexpr double kSceneCubeHalf = kCubeHalfSize;
 
 /// The scene of an environment (call it after reset(): before, the objects are not yet placed).
 Scene scene_of(const Env& env);

@@ -1,18 +1,27 @@
 #pragma once
 /// \file
-/// The five ManiSkill3 table-top tasks: names, horizons, observation layouts, and their success
-/// predicates and dense rewards as pure functions of a state snapshot (docs/sim.md §5; docs/reference.md, "Panda and tasks").
+/// The five ManiSkill3 table-top tasks, each described once (TaskDescription: name, ManiSkill source,
+/// horizon, rest keyframe, spawn distribution, observation layout, success and reward, scene geometry,
+/// camera, competence floor). The simulator, the policies, the renderer and the Python module read
+/// the description; nothing else knows a task (docs/sim.md §5, "What a task defines").
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include <array>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+namespace actionshift {
+class Rng;
+}
+
 namespace actionshift::sim {
+
+struct Scene;
 
 enum class TaskId {
   kPickCube,          ///< "pick_cube": lift the cube to a goal point (horizon 50)
@@ -21,6 +30,23 @@ enum class TaskId {
   kStackCube,         ///< "stack_cube": put cube A on cube B and let go (horizon 50)
   kPegInsertionSide,  ///< "peg_insertion_side": insert the peg sideways into the box hole (horizon 100)
 };
+
+/// ManiSkill's table (TableSceneBuilder, mani_skill/utils/scene_builder/table/scene_builder.py): a box
+/// of these half extents whose top face is the plane z = 0, centred at x = -0.12; the floor lies
+/// kTableHeight below the top.
+struct TableGeometry {
+  double half_x{0.6045}, half_y{1.209}, half_z{0.45982};  ///< [m] half extents of the collision box
+  double center_x{-0.12};                                 ///< [m] box centre x (y = 0, z = -half_z)
+  double height{0.9196429};                               ///< [m] table top above the floor
+};
+inline constexpr TableGeometry kTable{};
+
+/// Half side of every task cube [m] (ManiSkill's PickCube/PushCube/PullCube/StackCube `cube_half_size`).
+inline constexpr double kCubeHalfSize = 0.02;
+/// Density of every task object [kg/m^3] (SAPIEN's default).
+inline constexpr double kObjectDensity = 1000.0;
+/// PegInsertionSide's hole clearance [m] (ManiSkill's `clearance`): hole half width = peg radius + this.
+inline constexpr double kPegHoleClearance = 0.003;
 
 /// The task's snake_case name (pick_cube, push_cube, pull_cube, stack_cube, peg_insertion_side).
 std::string_view task_name(TaskId task);
@@ -92,5 +118,75 @@ TaskEvaluation evaluate_task(TaskId task, const TaskSnapshot& s);
 /// direction (left +y of the hand, right -y).
 bool is_grasping(const Eigen::Vector3d& force_left, const Eigen::Vector3d& force_right,
                  const Eigen::Vector3d& hand_y_axis, double min_force_n = 0.5, double max_angle_deg = 85.0);
+
+/// One box of a task object, in the object's frame.
+struct TaskBox {
+  Eigen::Vector3d half_extents{Eigen::Vector3d::Zero()};  ///< [m]
+  Eigen::Vector3d offset{Eigen::Vector3d::Zero()};        ///< [m] box centre in the object frame (axes aligned)
+};
+
+/// PegInsertionSide's box with a hole along its x axis: ManiSkill's `_build_box_with_hole`, four
+/// static boxes around a square hole of half width `hole_half_width` whose centre sits at
+/// `hole_offset` (0, cy, cz) in the box frame; the box's half depth and half height are the peg's
+/// half length. The one copy of this geometry: the simulator collides with it, the renderer draws it.
+std::array<TaskBox, 4> box_with_hole(double peg_half_length, double hole_half_width, const Eigen::Vector3d& hole_offset);
+
+/// One task object as spawned: dynamic when mass > 0, static otherwise.
+struct TaskObject {
+  std::vector<TaskBox> boxes;
+  double mass{0.0};  ///< [kg]
+  Eigen::Vector3d position{Eigen::Vector3d::Zero()};
+  Eigen::Quaterniond orientation{Eigen::Quaterniond::Identity()};
+};
+
+/// What a task's spawn draws for one episode: its objects (index 0: cube / cube A / peg; 1: cube B /
+/// box) and the episode parameters the observation, success and reward read.
+struct TaskEpisode {
+  std::vector<TaskObject> objects;
+  Eigen::Vector3d goal{Eigen::Vector3d::Zero()};
+  double peg_half_length{0.0}, peg_half_width{0.0}, hole_half_width{0.0};
+  Eigen::Vector3d hole_offset{Eigen::Vector3d::Zero()};
+};
+
+/// Which observation fields hold what a scripted policy reads (empty: the task has none).
+struct TaskObsRoles {
+  std::string_view object;    ///< pose of the manipulated object (cube, cube A, peg)
+  std::string_view object_b;  ///< pose of the second object (cube B, the box's hole)
+  std::string_view goal;      ///< goal position
+  std::string_view grasped;   ///< is_grasped flag
+};
+
+/// A renderer's default view of the task (ManiSkill's human-render camera).
+struct TaskCamera {
+  Eigen::Vector3d eye{Eigen::Vector3d::Zero()};     ///< [m]
+  Eigen::Vector3d target{Eigen::Vector3d::Zero()};  ///< [m]
+};
+
+/// Everything that makes a task, in one place (src/sim/task.cpp holds the five). Adding a task:
+/// an enumerator in TaskId and a description in src/sim/task.cpp, plus its tests (docs/sim.md §5).
+struct TaskDescription {
+  TaskId id;
+  std::string_view name;              ///< snake_case name (CLI, records, job ids)
+  std::string_view maniskill_id;      ///< ManiSkill environment id, e.g. "PickCube-v1"
+  std::string_view maniskill_source;  ///< where ManiSkill defines it (spawn, observation, success, reward)
+  int horizon;                        ///< control steps per episode
+  double rest_wrist;                  ///< [rad] joint 7 of the rest keyframe: pi/4 (panda) or -pi/4 (panda_wristcam)
+  double gate0_floor;                 ///< reference competence floor of a backbone (Gate 0)
+  const ObservationLayout& (*layout)();  ///< the flat state observation's fields
+  TaskObsRoles roles;                 ///< the fields scripted policies read
+  std::optional<TaskCamera> camera;   ///< the renderer's default view; empty: the renderer's default
+  /// Draw one episode's objects and parameters from `rng`, in the documented order (after the robot's
+  /// joint noise).
+  void (*spawn)(Rng& rng, TaskEpisode& out);
+  /// Write the task-specific fields of the observation (qpos, qvel and tcp_pose are written by Env).
+  void (*observe)(const TaskSnapshot& s, const ObservationLayout& layout, Eigen::VectorXd& obs);
+  /// Success exactly as ManiSkill, dense reward as ManiSkill's normalized_dense.
+  TaskEvaluation (*evaluate)(const TaskSnapshot& s);
+  /// Append the task's objects and goal marker to a scene (sim/scene.hpp) for renderers.
+  void (*draw)(const TaskSnapshot& s, Scene& scene);
+};
+
+/// The description of a task (one static object per task).
+const TaskDescription& task_description(TaskId task);
 
 }  // namespace actionshift::sim
