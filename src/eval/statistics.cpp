@@ -51,6 +51,22 @@ void check_bootstrap_args(double confidence, std::size_t samples) {
 }
 
 // resampled means of `values`, sorted; integer-valued inputs keep exact sums
+// the percentile interval of resampled statistics around `estimate`
+BootstrapInterval percentile_interval(std::vector<double> stats, double estimate, double confidence, std::size_t pairs,
+                                      std::uint64_t seed) {
+  std::sort(stats.begin(), stats.end());
+  BootstrapInterval out;
+  out.estimate = estimate;
+  const double alpha = (1.0 - confidence) / 2.0;
+  out.lower = linear_quantile(stats, alpha);
+  out.upper = linear_quantile(stats, 1.0 - alpha);
+  out.confidence = confidence;
+  out.samples = stats.size();
+  out.pairs = pairs;
+  out.seed = seed;
+  return out;
+}
+
 BootstrapInterval percentile_bootstrap(const std::vector<double>& values, double confidence,
                                        std::size_t samples, std::uint64_t seed) {
   const std::size_t n = values.size();
@@ -61,19 +77,9 @@ BootstrapInterval percentile_bootstrap(const std::vector<double>& values, double
     for (std::size_t k = 0; k < n; ++k) sum += values[rng.below(n)];
     means[s] = sum / static_cast<double>(n);
   }
-  std::sort(means.begin(), means.end());
   double total = 0.0;
   for (double v : values) total += v;
-  BootstrapInterval out;
-  out.estimate = total / static_cast<double>(n);
-  const double alpha = (1.0 - confidence) / 2.0;
-  out.lower = linear_quantile(means, alpha);
-  out.upper = linear_quantile(means, 1.0 - alpha);
-  out.confidence = confidence;
-  out.samples = samples;
-  out.pairs = n;
-  out.seed = seed;
-  return out;
+  return percentile_interval(std::move(means), total / static_cast<double>(n), confidence, n, seed);
 }
 
 }  // namespace
@@ -156,17 +162,7 @@ BootstrapInterval hierarchical_bootstrap(const ClusteredValues& values, double c
     }
     stats[r] = over_backbones / static_cast<double>(block_means.size());
   }
-  std::sort(stats.begin(), stats.end());
-  BootstrapInterval out;
-  out.estimate = mean_of(backbone_means);
-  const double alpha = (1.0 - confidence) / 2.0;
-  out.lower = linear_quantile(stats, alpha);
-  out.upper = linear_quantile(stats, 1.0 - alpha);
-  out.confidence = confidence;
-  out.samples = samples;
-  out.pairs = episodes;
-  out.seed = seed;
-  return out;
+  return percentile_interval(std::move(stats), mean_of(backbone_means), confidence, episodes, seed);
 }
 
 TwoProportionSummary two_proportion_summary(std::int64_t successes_a, std::int64_t total_a,
