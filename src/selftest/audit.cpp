@@ -205,6 +205,8 @@ std::string validate(const AuditOptions& o) {
     return "audit options: confidence_floor must be in (0, 1] (got " + fmt("%g", o.confidence_floor) + ")";
   if (!(o.misspec_ratio > 0.0) || !std::isfinite(o.misspec_ratio))
     return "audit options: misspec_ratio must be finite and > 0 (got " + fmt("%g", o.misspec_ratio) + ")";
+  if (!(o.gain_tolerance >= 1.0) || !std::isfinite(o.gain_tolerance))
+    return "audit options: gain_tolerance must be finite and >= 1 (got " + fmt("%g", o.gain_tolerance) + ")";
   if (!(o.min_rotation_spread >= 0.0) || !std::isfinite(o.min_rotation_spread))
     return "audit options: min_rotation_spread must be finite and >= 0";
   if (o.model) {
@@ -881,6 +883,53 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   R.fields.push_back(per_channel(Field::kSign, P.p_sign));
   {
     AuditField s = per_channel(Field::kScale, P.p_scale);
+    if (commands && !R.model_fitted) {
+      // The calibrated gain describes the calibration's motion (random walks); a log's motion runs at
+      // another gain (sustained commands, contacts), so a channel's scale is the set of grid values
+      // within the gain tolerance of the log's least-squares gain / calibrated gain (widened by two
+      // standard errors). The declaration agrees if its scale is in that band; it differs if the
+      // channel's routing is resolved and its declared scale is outside the band.
+      const int f = map.frame() == Frame::kTool ? 1 : 0;
+      std::vector<std::string> parts, diffs;
+      s.unresolved_channels.clear();
+      s.confidence = 1.0;
+      for (int i = 0; i < kPoseDim; ++i) {
+        const auto ii = static_cast<std::size_t>(i);
+        double sxy = 0, sxx = 0;
+        for (const auto& ep : eps)
+          for (std::size_t t = 0; t < ep.size(); ++t) {
+            const double d = drive(ep, t, map.target(), map.lag(), map.permutation()[ii]);
+            sxy += working(ep[t], alpha, f)[i] * d;
+            sxx += d * d;
+          }
+        const double g = sxx > 0 ? std::abs(sxy / sxx) : 0.0;
+        const double se = sxx > 0 ? sigma_used[ii] / std::sqrt(sxx) : std::numeric_limits<double>::infinity();
+        const double lo = g / o.gain_tolerance - 2 * se, hi = g * o.gain_tolerance + 2 * se;
+        R.scale_band[ii] = {std::max(lo, 0.0), hi};
+        std::vector<std::string> in;
+        for (double k : grammar::kScaleGrid)
+          if (k >= lo && k <= hi) in.push_back(python_float_repr(k));
+        const bool routed = P.p_perm[ii] >= floor && P.p_sign[ii] >= floor;
+        const bool ok = routed && !in.empty() && in.size() < grammar::kScaleGrid.size();
+        if (!ok) {
+          s.unresolved_channels.push_back(i);
+          s.confidence = 0.0;
+        }
+        parts.push_back(ok ? join(in, "|") : "?");
+        const double dk = dc.scale()[ii];
+        if (ok && !(dk >= lo && dk <= hi))
+          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") scale " + python_float_repr(dk) + "->" + join(in, " or ") +
+                          " (the log's gain is " + fmt("%.2f", g) + "x the calibrated one)");
+      }
+      s.identified = "(" + join(parts, ", ") + ")";
+      s.resolved = s.unresolved_channels.empty();
+      s.diff = join(diffs, "; ");
+      s.reason.clear();
+      if (!s.resolved)
+        s.reason = "not resolved on output channel(s) " + channel_list(s.unresolved_channels) +
+                   ": their routing is not resolved, or the log's gain fits no grid scale or every one within the gain tolerance x" +
+                   fmt("%.2f", o.gain_tolerance) + "; longer motion on those channels would decide";
+    }
     if (R.model_fitted && commands) {
       s.checked = false;
       s.reason = "no response calibration: a log cannot separate the contract's scale from the robot's response gain; "
@@ -996,6 +1045,7 @@ nlohmann::json to_json_value(const AuditResult& r) {
   j["model_fitted"] = r.model_fitted;
   j["alpha"] = r.alpha;
   j["effective_gain"] = r.effective_gain;
+  j["scale_band"] = r.scale_band;
   j["excitation"] = r.excitation;
   j["episodes"] = r.episodes;
   j["transitions"] = r.transitions;

@@ -105,7 +105,12 @@ struct AuditOptions {
   std::optional<adapt::ResponseModel> model;
   double confidence_floor{0.99};   ///< a field (channel) is resolved iff its posterior mass >= this, in (0, 1]
   double misspec_ratio{25.0};      ///< abstain when the best contract fits worse than this × the calibrated noise variance
-  double min_rotation_spread{0.2}; ///< [rad] the frame is checked only if the TCP orientation varies this much
+  double min_rotation_spread{0.2}; ///< [rad] the TCP turn the report asks for when the frame is not resolved
+  /// How far (a factor) a log's response gain may lie from the calibrated one: the calibration's random
+  /// walks and a policy's sustained motion run at different gains (measured on the simulator: up to
+  /// 1.33x on z for the scripted expert). A channel's scale is the set of grid values within this
+  /// factor of the log's gain / calibrated gain.
+  double gain_tolerance{1.4};
 };
 /// One line naming the field and rule, or "" if valid.
 std::string validate(const AuditOptions& o);
@@ -136,6 +141,9 @@ struct AuditResult {
   bool model_fitted{false};            ///< the response model was fitted from the log
   std::array<double, kPoseDim> alpha{};      ///< response gain used per output channel
   std::array<double, kPoseDim> effective_gain{};  ///< α·sign·scale of the MAP per output channel
+  /// Per output channel, the scales consistent with the log: [lo, hi] of the log's gain / calibrated gain
+  /// widened by the gain tolerance and two standard errors (calibrated model only).
+  std::array<std::array<double, 2>, kPoseDim> scale_band{};
   std::array<double, kPoseDim> excitation{};      ///< RMS raw command per raw channel
   std::size_t episodes{0};
   std::size_t transitions{0};
