@@ -164,9 +164,7 @@ int record(const RecordOptions& o) {
     selftest::Conventions c;
     c.contract = truth;
     nlohmann::json j = c.to_json_value();
-    j["job_id"] = eval::job_id(job);
-    j["split"] = job.split.name;
-    j["contract_index"] = o.contract;
+    j["recorded"] = {{"job_id", eval::job_id(job)}, {"split", job.split.name}, {"contract_index", o.contract}};
     weight_file::write_atomic(o.truth, j.dump(2) + "\n");
   }
   nlohmann::json line{{"log", o.out},          {"job_id", eval::job_id(job)}, {"contract_index", o.contract},

@@ -122,8 +122,8 @@ Conventions Conventions::from_json_value(const nlohmann::json& j, const std::str
   }
   if (bare) return c;
   for (auto it = j.begin(); it != j.end(); ++it)
-    if (it.key() != "contract" && it.key() != "rotation" && it.key() != "gripper_range" && it.key() != "action")
-      throw InputError(source, it.key(), "unknown key (expected contract, rotation, gripper_range, action)");
+    if (it.key() != "contract" && it.key() != "rotation" && it.key() != "gripper_range" && it.key() != "action" && it.key() != "recorded")
+      throw InputError(source, it.key(), "unknown key (expected contract, rotation, gripper_range, action, recorded)");
   const auto text = [&](const char* key) -> std::optional<std::string> {
     if (!j.contains(key)) return std::nullopt;
     if (!j[key].is_string()) throw InputError(source, key, "must be a string");

@@ -67,7 +67,8 @@ struct Conventions {
   /// {"contract": {...}, "rotation": "...", "gripper_range": "...", "action": "..."}.
   nlohmann::json to_json_value() const;
   /// Accepts either a bare contract object (the seven contract keys; the extension at its defaults) or
-  /// the object above (every key but "contract" optional). Throws InputError(source, field, reason).
+  /// the object above (every key optional; a "recorded" object, the provenance `actionshift record
+  /// --truth` writes, is ignored). Throws InputError(source, field, reason).
   static Conventions from_json_value(const nlohmann::json& j, const std::string& source);
 };
 
