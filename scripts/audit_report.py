@@ -2,8 +2,8 @@
 """The audit benchmark's page (docs/results/audit.md) and its coverage plot, from the JSON of
 `actionshift audit --json` that scripts/audit_benchmark wrote (each with a `bench` block: the recorded
 contract, split, noise, seed, length, declaration). Counting only: which verdicts committed, which were
-wrong, which fields resolved and whether to the recorded value. `--choose-floor DIR` prints the smallest
-floor of the pilot grid with no wrong committed verdict (the benchmark's only chosen threshold)."""
+wrong, which fields resolved and whether to the recorded value. `--choose DIR` prints the pilot's chosen
+(floor, gain tolerance) pair, the only thresholds the benchmark chooses."""
 import argparse
 import glob
 import json
@@ -91,19 +91,25 @@ def load(d):
     return out
 
 
-def choose_floor(pilot_dir):
-    by_floor = {}
-    for a in load(pilot_dir):
-        fl = a["bench"]["floor"]
+def pilot_table(pilot):
+    """(floor, tolerance) -> [audits, committed, wrong]."""
+    by = {}
+    for a in pilot:
+        key = (a["bench"]["floor"], a["bench"]["gain_tolerance"])
         w = verdict_wrong(a)
-        by_floor.setdefault(fl, [0, 0])
+        by.setdefault(key, [0, 0, 0])
+        by[key][0] += 1
         if w is not None:
-            by_floor[fl][0] += 1
-            by_floor[fl][1] += int(w)
-    ok = sorted(fl for fl, (n, wrong) in by_floor.items() if wrong == 0)
-    if not ok:
-        return max(by_floor)
-    return ok[0]
+            by[key][1] += 1
+            by[key][2] += int(w)
+    return by
+
+
+def choose(pilot_dir):
+    """The pair with no wrong committed pilot verdict and the highest pilot coverage (ties: the larger
+    floor, then the smaller tolerance); with none clean, the fewest wrong."""
+    by = pilot_table(load(pilot_dir))
+    return min(by, key=lambda k: (by[k][2], -by[k][1], -k[0], k[1]))
 
 
 def fmt_floor(x):
@@ -185,7 +191,9 @@ def svg(stats_by_group, lengths, path):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--choose-floor")
+    ap.add_argument("--choose")
+    ap.add_argument("--tolerance")
+    ap.add_argument("--tolerances", default="")
     ap.add_argument("--out")
     ap.add_argument("--svg")
     ap.add_argument("--pilot")
@@ -200,8 +208,9 @@ def main():
     ap.add_argument("--noises", default="")
     ap.add_argument("--floors", default="")
     a = ap.parse_args()
-    if a.choose_floor:
-        print(fmt_floor(choose_floor(a.choose_floor)))
+    if a.choose:
+        fl, tol = choose(a.choose)
+        print(fmt_floor(fl), fmt_floor(tol))
         return
     lengths = [int(x) for x in a.lengths.split()]
     ev = load(a.evaluation)
@@ -215,11 +224,8 @@ def main():
     svg(groups, lengths, a.svg)
     # the pilot's grid
     pilot_rows = []
-    for fl in sorted({p["bench"]["floor"] for p in pilot}):
-        sel = [p for p in pilot if p["bench"]["floor"] == fl]
-        com = [p for p in sel if p["status"] != "INCONCLUSIVE"]
-        wrong = sum(1 for p in com if verdict_wrong(p))
-        pilot_rows.append([fmt_floor(fl), str(len(sel)), f"{len(com) / len(sel):.3f}", f"{wrong} / {len(com)}"])
+    for (fl, tol), (n, com, wrong) in sorted(pilot_table(pilot).items()):
+        pilot_rows.append([fmt_floor(fl), fmt_floor(tol), str(n), f"{com / n:.3f}", f"{wrong} / {com}"])
     worst = max((stats[L][2] / stats[L][1] if stats[L][1] else 0.0) for L in lengths)
     lines = []
     lines.append("# Audit benchmark: identifying a log's action contract, with abstention\n")
@@ -235,11 +241,13 @@ def main():
                  "prefixes of the same log (`audit --max-steps`). Each log is audited twice: declared = the recorded contract "
                  "(right answer PASS) and declared = identity (right answer MISMATCH naming the recorded contract). Response model: "
                  "the task's built-in calibration (`--task pick_cube`).\n")
-    lines.append(f"**Seeds.** Pilot (choose the confidence floor): {a.pilot_seeds}. Evaluation (this page): {a.eval_seeds}; "
+    lines.append(f"**Seeds.** Pilot (choose the confidence floor and the gain tolerance): {a.pilot_seeds}. Evaluation (this page): {a.eval_seeds}; "
                  "both registered in `configs/seeds.yaml` and checked disjoint (initial states included) by "
                  "`tests/eval/seed_registry_test.cpp`.\n")
-    lines.append(f"**Threshold.** The confidence floor is the smallest of the grid {{{', '.join(a.floors.split())}}} with no wrong "
-                 f"committed verdict among the pilot audits: **{a.floor}**. The misspecification ratio is the default (not tuned).\n")
+    lines.append(f"**Thresholds.** The confidence floor (grid {{{', '.join(a.floors.split())}}}) and the gain tolerance (grid "
+                 f"{{{', '.join(a.tolerances.split())}}}) are the pair with no wrong committed verdict among the pilot audits and the "
+                 f"highest pilot coverage: **floor {a.floor}, gain tolerance {a.tolerance}**. The misspecification ratio (25) and the "
+                 "minimum excitation (0.1) are the defaults, fixed before the run (not tuned).\n")
     lines.append("**Wrong.** A committed verdict is wrong if it is PASS while a checked field of the recorded conventions differs "
                  "from the declaration, or MISMATCH while the declaration is the truth or any resolved field (per output "
                  "channel for permutation, sign and scale) is not the recorded value.\n")
@@ -253,8 +261,8 @@ def main():
                  "representation at these rotation sizes: the representations differ at second order only).\n")
     lines.append(table.markdown(["field"] + [f"{L} transitions" for L in lengths], field_rows(ev, lengths)))
     lines.append("")
-    lines.append("## Pilot (floor grid)\n")
-    lines.append(table.markdown(["floor", "audits", "coverage", "wrong / committed"], pilot_rows))
+    lines.append("## Pilot (the grid of floors and gain tolerances)\n")
+    lines.append(table.markdown(["floor", "gain tolerance", "audits", "coverage", "wrong / committed"], pilot_rows))
     lines.append("")
     lines.append("Scale is checked against the task's calibrated response gain. Without a calibration the audit fits the gain "
                  "from the log and reports scale relative to it (unchecked): a log cannot separate a contract's scale from "

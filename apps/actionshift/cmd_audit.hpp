@@ -26,7 +26,7 @@ struct AuditCliOptions {
   std::string profile{"maniskill"};   ///< --profile: with --task
   double confidence_floor{0.99};
   double misspec_ratio{25.0};
-  double gain_tolerance{1.4};
+  double gain_tolerance{1.8};
   std::optional<long long> max_steps; ///< --max-steps N: audit only the first N transitions
   bool json{false};
 };

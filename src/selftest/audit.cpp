@@ -205,6 +205,8 @@ std::string validate(const AuditOptions& o) {
     return "audit options: confidence_floor must be in (0, 1] (got " + fmt("%g", o.confidence_floor) + ")";
   if (!(o.misspec_ratio > 0.0) || !std::isfinite(o.misspec_ratio))
     return "audit options: misspec_ratio must be finite and > 0 (got " + fmt("%g", o.misspec_ratio) + ")";
+  if (!(o.min_excitation >= 0.0) || !std::isfinite(o.min_excitation))
+    return "audit options: min_excitation must be finite and >= 0 (got " + fmt("%g", o.min_excitation) + ")";
   if (!(o.gain_tolerance >= 1.0) || !std::isfinite(o.gain_tolerance))
     return "audit options: gain_tolerance must be finite and >= 1 (got " + fmt("%g", o.gain_tolerance) + ")";
   if (!(o.min_rotation_spread >= 0.0) || !std::isfinite(o.min_rotation_spread))
@@ -690,6 +692,14 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     P = posterior(evidence(eps, alpha, sigma_used));
   }
 
+  // a channel whose source is hardly commanded is not resolved, whatever its posterior: in a closed-loop
+  // log a policy's small corrections answer disturbances, which biases their apparent response
+  if (commands)
+    for (int i = 0; i < kPoseDim; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      if (R.excitation[static_cast<std::size_t>(P.perm[ii])] < o.min_excitation) P.p_perm[ii] = P.p_sign[ii] = P.p_scale[ii] = 0.0;
+    }
+
   // 4. the gripper: range from the numbers, polarity from the fingers (lag of the grammar's MAP)
   GripperRange range = o.declared.gripper_range;
   double range_conf = 0;
@@ -870,9 +880,9 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
       for (int i : a.unresolved_channels) raw.push_back(map.permutation()[static_cast<std::size_t>(i)]);
       std::string weak;
       for (int j = 0; j < kPoseDim; ++j)
-        if (R.excitation[static_cast<std::size_t>(j)] < 0.1) weak += (weak.empty() ? "" : ", ") + std::to_string(j);
+        if (R.excitation[static_cast<std::size_t>(j)] < o.min_excitation) weak += (weak.empty() ? "" : ", ") + std::to_string(j);
       a.reason = "not resolved on output channel(s) " + channel_list(a.unresolved_channels) +
-                 (weak.empty() ? "" : "; raw channel(s) " + weak + " hardly move (RMS command < 0.1)") +
+                 (weak.empty() ? "" : "; raw channel(s) " + weak + " hardly move (RMS command < " + fmt("%g", o.min_excitation) + ")") +
                  "; a log that commands every channel, positive and negative, on its own and in reversals, would decide";
       if (f == Field::kSign || f == Field::kPermutation)
         a.reason += "; with the TCP orientation nearly constant, a tool-frame contract equals a base-frame one with other signs and channels, so also rotate the TCP";

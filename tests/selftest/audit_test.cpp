@@ -76,7 +76,7 @@ TEST(Audit, MismatchIsSaidInWords) {
   EXPECT_THAT(r.reason, HasSubstr("reference frame differs: declared base, the log is tool"));
   EXPECT_THAT(r.reason, HasSubstr("gripper polarity differs"));
   EXPECT_THAT(r.reason, HasSubstr("channels [0, 2, 4] sign FLIPPED"));
-  EXPECT_THAT(r.reason, HasSubstr("channel 5 (rz) scale 1.0->0.5 or 0.6 or 0.75 (the log's gain is 0.64x the calibrated one)"));
+  EXPECT_THAT(r.reason, HasSubstr("channel 0 (x) scale 1.0->0.5 or 0.6 or 0.75 (the log's gain is 0.48x the calibrated one)"));
   EXPECT_THAT(to_text(r), HasSubstr("VERDICT: MISMATCH (exit 1)"));
 }
 

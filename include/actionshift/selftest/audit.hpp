@@ -108,10 +108,14 @@ struct AuditOptions {
   double misspec_ratio{25.0};      ///< abstain when the best contract fits worse than this × the calibrated noise variance
   double min_rotation_spread{0.2}; ///< [rad] the TCP turn the report asks for when the frame is not resolved
   /// How far (a factor) a log's response gain may lie from the calibrated one: the calibration's random
-  /// walks and a policy's sustained motion run at different gains (measured on the simulator: up to
-  /// 1.33x on z for the scripted expert). A channel's scale is the set of grid values within this
-  /// factor of the log's gain / calibrated gain.
-  double gain_tolerance{1.4};
+  /// walks and a policy's sustained motion run at different gains (measured on the simulator: about
+  /// 1.7x on z for the scripted expert against the built-in calibration). A channel's scale is the set
+  /// of grid values within this factor of the log's gain / calibrated gain.
+  double gain_tolerance{1.8};
+  /// A raw channel commanded with an RMS below this (normalised units) resolves no output channel: in a
+  /// closed-loop log a policy's small corrections answer disturbances, which biases their apparent
+  /// response (measured on the simulator: a sign read backwards at RMS 0.04).
+  double min_excitation{0.1};
 };
 /// One line naming the field and rule, or "" if valid.
 std::string validate(const AuditOptions& o);
