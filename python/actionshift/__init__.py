@@ -459,10 +459,16 @@ def audit(log=None, *, actions=None, tcp_pos=None, tcp_quat=None, fingers=None, 
     or None (gains fitted from the log; scale is then reported relative to them, unchecked)."""
     source = "arrays"
     if log is not None:
-        if not isinstance(log, (str, _os.PathLike)) or not str(log).endswith(".npz"):
-            raise InputError(f"audit: log must be a path to an .npz file (got {log!r}); pass arrays by keyword")
-        source = str(log)
-        with _np.load(log) as z:
+        if not isinstance(log, (str, _os.PathLike)):
+            raise InputError(f"audit: log must be a path to an .npz file (got a {type(log).__name__}); pass arrays by keyword")
+        source = repr(str(log))[1:-1]  # one line whatever the path holds
+        if not str(log).endswith(".npz"):
+            raise InputError(f"audit: log must be a path to an .npz file (got '{source}'); pass arrays by keyword")
+        try:
+            z = _np.load(log)
+        except (OSError, ValueError) as e:
+            raise InputError(f"{source}: cannot read the .npz file ({type(e).__name__})") from None
+        with z:
             missing = [k for k in ("actions", "tcp_pos", "tcp_quat") if k not in z.files]
             if missing:
                 raise InputError(f"{source}: {missing[0]}: missing array")
