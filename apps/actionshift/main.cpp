@@ -2,6 +2,7 @@
 // Each subcommand fills an options struct and calls a plain function (commands.hpp).
 // Exit codes: 0 ok, 1 a check/gate failed, 2 bad input or usage, 130 a job stopped by Ctrl-C or
 // SIGTERM. One-line errors on stderr.
+#include "cmd_audit.hpp"
 #include "cmd_bench_adapt.hpp"
 #include "cmd_identifier.hpp"
 #include "cmd_policy.hpp"
@@ -390,6 +391,48 @@ int main(int argc, char** argv) {
   st->add_flag("--json", st_o.json, "Print one JSON object instead of the text report");
   add_robot_options(st, st_o.robot);
   st->callback([&] { action = [&] { return cli::run_selftest(st_o); }; });
+
+  // ---- audit | record (issue 37: a recorded log's action contract, docs/audit.md)
+  cli::AuditCliOptions audit_o;
+  auto* audit = app.add_subcommand(
+      "audit",
+      "Audit a log: identify the action contract of recorded data (commanded actions + measured TCP poses) without\n"
+      "probing. PASS, MISMATCH (the contract of the grammar that explains the log, in words) or INCONCLUSIVE\n"
+      "(which fields the log does not excite, and what motion would decide). See docs/audit.md.");
+  audit->footer("Exit codes: 0 PASS, 1 MISMATCH, 2 bad input or usage, 3 INCONCLUSIVE.");
+  audit->add_option("log", audit_o.log, "The log: .csv, .jsonl, or .h5/.hdf5 (ManiSkill trajectory or robomimic layout)")
+      ->required()->check(kNotEmpty);
+  audit->add_option("--declared", audit_o.declared,
+                    "The declared convention: a contract (library name, MANIFEST:INDEX, file or inline JSON) or a conventions\n"
+                    "JSON {\"contract\": ..., \"rotation\": ..., \"gripper_range\": ..., \"action\": ...} (default: what the file\n"
+                    "declares, e.g. ManiSkill's control_mode, else identity)");
+  audit->add_option("--rotation", audit_o.rotation, "Declared rotation representation: axis_angle, euler_xyz or euler_zyx");
+  audit->add_option("--gripper-range", audit_o.gripper_range, "Declared gripper range: -1..1 or 0..1");
+  audit->add_option("--action-kind", audit_o.action_kind, "Declared meaning of the action: command, next_state or current_state");
+  auto* audit_cal = audit->add_option("--calibration", audit_o.calibration, "Response calibration JSON (per-channel gain and noise)");
+  audit->add_option("--task", audit_o.task, "Use this task's built-in calibration (pick_cube, ...)")->excludes(audit_cal);
+  audit->add_option("--profile", audit_o.profile, "With --task: the simulator profile of the calibration")->check(kProfile)
+      ->capture_default_str();
+  audit->add_option("--confidence-floor", audit_o.confidence_floor, "Posterior mass a field needs to be resolved")->capture_default_str();
+  audit->add_option("--misspec-ratio", audit_o.misspec_ratio, "Abstain when the best contract fits worse than this x the calibrated noise variance")
+      ->capture_default_str();
+  audit->add_option("--gain-tolerance", audit_o.gain_tolerance,
+                    "Factor by which a log's response gain may differ from the calibrated one (scale is the set of grid\n"
+                    "values within it)")->capture_default_str();
+  audit->add_option("--max-steps", audit_o.max_steps, "Audit only the first N transitions");
+  audit->add_flag("--json", audit_o.json, "Print one JSON object instead of the text report");
+  audit->callback([&] { action = [&] { return cli::run_audit(audit_o); }; });
+
+  cli::RecordOptions record_o;
+  auto* record = app.add_subcommand(
+      "record", "Write a log (actions, TCP poses, fingers) of one contract of a job from the simulator, for `audit` (docs/audit.md)");
+  add_job_options(record, record_o.job, /*required=*/true);
+  record->add_option("--contract", record_o.contract, "The split's contract to record (its episodes of the job)")->capture_default_str();
+  record->add_option("--steps", record_o.steps, "Stop once this many transitions are logged");
+  record->add_option("--out", record_o.out, "The log: .csv, .jsonl or .h5")->required()->check(kNotEmpty);
+  record->add_option("--layout", record_o.layout, "For .h5: maniskill or robomimic")->capture_default_str();
+  record->add_option("--truth", record_o.truth, "Write the recorded contract (conventions JSON) to this file");
+  record->callback([&] { action = [&] { return cli::run_record(record_o); }; });
 
   // ---- train bc | gate0 (policy layer)
   auto* train = app.add_subcommand("train", "Train backbones and identifiers");

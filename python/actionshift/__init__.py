@@ -54,7 +54,7 @@ __git_commit__ = _native.__git_commit__
 """The commit checked out when CMake configured this build (None if it was not a git checkout)."""
 
 __all__ = [
-    "Adapter", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
+    "Adapter", "audit", "Box", "Contract", "Decoder", "Env", "InputError", "Manifest", "SelfTest", "VecEnv",
     "builtin_manifests", "decode", "decode_jacobian", "encode", "episode_seed", "evaluate", "load_manifest", "make",
     "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
     "method_rung", "PoolBelief", "ResponseModel",
@@ -627,3 +627,69 @@ def _register_gymnasium():
 
 
 _register_gymnasium()
+
+
+def audit(log=None, *, actions=None, tcp_pos=None, tcp_quat=None, fingers=None, episode=None, declared="identity",
+          model=None, confidence_floor=0.99, misspec_ratio=25.0, gain_tolerance=1.8):
+    """Audit a log: the action contract of recorded data (docs/audit.md). Returns the report as a dict
+    (the keys of `actionshift audit --json`: status PASS/MISMATCH/INCONCLUSIVE, reason, fields, ...).
+
+    The log is a path to an `.npz` (arrays `actions`, `tcp_pos`, `tcp_quat` and optionally `fingers`,
+    `episode`) or the arrays themselves: `actions` N x 7 (or N x 6 without gripper), `tcp_pos` N x 3 and
+    `tcp_quat` N x 4 (w, x, y, z) measured before each action, `fingers` N x 2, `episode` N integers
+    (consecutive equal ids form an episode). Without `episode`, tcp arrays of N + 1 rows add the final pose.
+    `declared`: a library contract name, a Contract, or a conventions dict {"contract": ..., "rotation": ...,
+    "gripper_range": ..., "action": ...}. `model`: a task name (its built-in calibration), a ResponseModel,
+    or None (gains fitted from the log; scale is then reported relative to them, unchecked)."""
+    source = "arrays"
+    if log is not None:
+        if not isinstance(log, (str, _os.PathLike)):
+            raise InputError(f"audit: log must be a path to an .npz file (got a {type(log).__name__}); pass arrays by keyword")
+        source = repr(str(log))[1:-1]  # one line whatever the path holds
+        if not str(log).endswith(".npz"):
+            raise InputError(f"audit: log must be a path to an .npz file (got '{source}'); pass arrays by keyword")
+        try:
+            z = _np.load(log)
+        except (OSError, ValueError) as e:
+            raise InputError(f"{source}: cannot read the .npz file ({type(e).__name__})") from None
+        with z:
+            missing = [k for k in ("actions", "tcp_pos", "tcp_quat") if k not in z.files]
+            if missing:
+                raise InputError(f"{source}: {missing[0]}: missing array")
+            actions, tcp_pos, tcp_quat = z["actions"], z["tcp_pos"], z["tcp_quat"]
+            fingers = z["fingers"] if "fingers" in z.files else None
+            episode = z["episode"] if "episode" in z.files else None
+    if actions is None or tcp_pos is None or tcp_quat is None:
+        raise InputError("audit: actions, tcp_pos and tcp_quat are required")
+    a = _np.asarray(actions, dtype=float)
+    p = _np.asarray(tcp_pos, dtype=float)
+    q = _np.asarray(tcp_quat, dtype=float)
+    f = None if fingers is None else _np.asarray(fingers, dtype=float)
+    for name, arr in (("actions", a), ("tcp_pos", p), ("tcp_quat", q), ("fingers", f)):
+        if arr is not None and not _np.all(_np.isfinite(arr)):
+            row = int(_np.argwhere(~_np.isfinite(arr))[0][0])
+            raise InputError(f"{source}: {name}: row {row}: not a finite number")
+    if a.ndim != 2:
+        raise InputError(f"{source}: actions: must be an N x 7 (or N x 6) array")
+    episodes = []
+    if episode is None:
+        if len(p) not in (len(a), len(a) + 1):
+            raise InputError(f"{source}: tcp_pos: {len(p)} rows for {len(a)} actions (need as many, or one more)")
+        episodes.append((a, p, q, f))
+    else:
+        ids = _np.asarray(episode).reshape(-1)
+        if len(ids) != len(a) or len(p) != len(a) or len(q) != len(a):
+            raise InputError(f"{source}: episode: actions, tcp_pos, tcp_quat and episode must have the same rows")
+        starts = [0] + [i for i in range(1, len(ids)) if ids[i] != ids[i - 1]] + [len(ids)]
+        seen = set()
+        for s, e in zip(starts[:-1], starts[1:]):
+            if ids[s] in seen:
+                raise InputError(f"{source}: episode: episode {ids[s]} appears again after another episode")
+            seen.add(ids[s])
+            episodes.append((a[s:e], p[s:e], q[s:e], None if f is None else f[s:e]))
+    if isinstance(declared, Contract):
+        declared = _json.dumps({"contract": declared.to_dict()})
+    elif isinstance(declared, dict):
+        declared = _json.dumps(declared)
+    return _native._audit(episodes, str(declared), model, float(confidence_floor), float(misspec_ratio), float(gain_tolerance),
+                          a.shape[1] == 7, source)

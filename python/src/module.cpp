@@ -30,6 +30,7 @@
 #include "actionshift/selftest/library.hpp"
 #include "actionshift/selftest/selftest.hpp"
 #include "actionshift/selftest/verdict.hpp"
+#include "actionshift/selftest/audit.hpp"
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
@@ -1938,4 +1939,60 @@ PYBIND11_MODULE(_native, m) {
     for (const auto& n : selftest::library()) out.emplace_back(n.name, n.contract);
     return out;
   });
+  // the log audit (docs/audit.md); actionshift.audit() in __init__.py shapes arrays or an .npz into episodes
+  m.def(
+      "_audit",
+      [](py::list episodes, const std::string& declared, py::object model, double floor, double misspec, double gain_tolerance,
+         bool has_gripper, const std::string& source) {
+        using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+        selftest::ActionLog log;
+        log.source = source;
+        log.layout = "arrays";
+        log.has_gripper = has_gripper;
+        for (std::size_t e = 0; e < episodes.size(); ++e) {
+          const auto t = episodes[e].cast<py::tuple>();
+          const std::string where = "episode " + std::to_string(e);
+          const Arr a = Arr::ensure(t[0]), p = Arr::ensure(t[1]), q = Arr::ensure(t[2]);
+          if (!a || a.ndim() != 2 || (a.shape(1) != 6 && a.shape(1) != 7)) throw InputError(source, where + ": actions", "must be an N x 6 or N x 7 array");
+          if (!p || p.ndim() != 2 || p.shape(1) != 3) throw InputError(source, where + ": tcp_pos", "must be an N x 3 array");
+          if (!q || q.ndim() != 2 || q.shape(1) != 4) throw InputError(source, where + ": tcp_quat", "must be an N x 4 array (w, x, y, z)");
+          if (p.shape(0) != q.shape(0)) throw InputError(source, where + ": tcp_quat", "rows differ from tcp_pos's");
+          Arr f;
+          if (!t[3].is_none()) {
+            f = Arr::ensure(t[3]);
+            if (!f || f.ndim() != 2 || f.shape(1) != 2 || f.shape(0) != p.shape(0)) throw InputError(source, where + ": fingers", "must be an N x 2 array with tcp_pos's rows");
+          }
+          selftest::LogEpisode ep;
+          for (py::ssize_t r = 0; r < a.shape(0); ++r) {
+            Action x = Action::Zero();
+            for (py::ssize_t k = 0; k < a.shape(1); ++k) x[static_cast<Eigen::Index>(k)] = a.at(r, k);
+            ep.actions.push_back(x);
+          }
+          for (py::ssize_t r = 0; r < p.shape(0); ++r) {
+            selftest::TcpPose pose;
+            pose.position = Vec3(p.at(r, 0), p.at(r, 1), p.at(r, 2));
+            pose.quaternion = Eigen::Vector4d(q.at(r, 0), q.at(r, 1), q.at(r, 2), q.at(r, 3));
+            if (f) pose.fingers = Eigen::Vector2d(f.at(r, 0), f.at(r, 1));
+            ep.poses.push_back(pose);
+          }
+          log.episodes.push_back(std::move(ep));
+        }
+        selftest::AuditOptions o;
+        if (!declared.empty() && declared.front() == '{') {
+          o.declared = selftest::Conventions::from_json_value(parse_json_input(declared, "declared"), "declared");
+        } else if (auto c = selftest::named_contract(declared)) {
+          o.declared.contract = *c;
+        } else {
+          throw InputError("declared", "", "unknown library contract " + quote_input(declared) + " (known: " + selftest::named_contract_list() + ")");
+        }
+        if (py::isinstance<py::str>(model)) o.model = eval::builtin_calibration(model.cast<std::string>()).model();
+        else if (!model.is_none()) o.model = model.cast<adapt::ResponseModel>();
+        o.confidence_floor = floor;
+        o.misspec_ratio = misspec;
+        o.gain_tolerance = gain_tolerance;
+        if (const std::string err = selftest::validate(o); !err.empty()) throw InputError("audit options", "", err);
+        return json_to_py(selftest::to_json(selftest::audit(log, o)));
+      },
+      py::arg("episodes"), py::arg("declared"), py::arg("model"), py::arg("confidence_floor"), py::arg("misspec_ratio"),
+      py::arg("gain_tolerance"), py::arg("has_gripper"), py::arg("source"));
 }

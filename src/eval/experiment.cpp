@@ -229,17 +229,17 @@ struct Context {
     EpisodeRecord rec;
     rec.contract_sha256 = truth.sha256();
     const sim::OracleRecorder view = detail::OracleAccess::view(env);
-    auto show = [&](int step, bool probe) {
-      if (hooks.observer) hooks.observer(EpisodeStepView{step, env.horizon(), probe, &env.last(), &view.env()});
+    auto show = [&](int step, bool probe, const Action* raw) {
+      if (hooks.observer) hooks.observer(EpisodeStepView{step, env.horizon(), probe, &env.last(), &view.env(), raw});
     };
-    show(0, false);
+    show(0, false, nullptr);
     for (int step = 0; step < env.horizon(); ++step) {
       const Action intent = w.policy->act(obs);
       const Mat3 R = rotation == sim::FrameRotation::kIdentity ? Mat3::Identity() : adapt::tcp_rotation(obs, slice);
       const Action raw = adapter->encode(intent, R);
       const bool probe = adapter->last_step().probe;
       const sim::StepResult& r = env.step(raw);
-      show(step + 1, probe);
+      show(step + 1, probe, &raw);
       if (r.safety != sim::SafetyFlag::kNone) break;  // the episode ended by a safety check
       const Pose6 response_now = adapt::tcp_response(obs, r.obs, slice);
       if (probe) {

@@ -93,6 +93,7 @@ struct EpisodeStepView {
   bool probe{false};                        ///< the action just taken was an adapter probe
   const sim::StepResult* result{nullptr};   ///< the environment's last result (success, safety)
   const sim::Env* env{nullptr};             ///< the unwrapped environment, read-only (for rendering)
+  const Action* raw{nullptr};               ///< the raw action just sent (null at step 0): what a log records
 };
 /// Called once per EpisodeStepView.
 using EpisodeObserver = std::function<void(const EpisodeStepView&)>;
