@@ -126,7 +126,8 @@ def main():
     w("")
     w("## The ladder per backbone")
     w("")
-    w("success_once [Wilson 95 %] over 3 seeds; figures (one line per backbone): "
+    w("success_once [Wilson 95 %] over the seeds, the paper's number (its one PPO checkpoint per task) where it "
+      "gives one for the cell; figures (one line per backbone): "
       + ", ".join(f"[{t}/{s}](backbone_variance/figures/ladder_by_backbone_{t}_{s}.svg)" for t in tasks for s in splits)
       + " (and [the report](backbone_variance/index.html) of every cell).")
     w("")
@@ -137,13 +138,16 @@ def main():
             rows = []
             for m in methods:
                 row = [f"`{m}`"]
+                paper = None
                 for b in backbones[t]:
                     c = next((c for c in cs if c["method"] == m and c["backbone"] == b), None)
                     row.append(fmt.cell_rate(c) if c else "—")
+                    paper = paper or ((c or {}).get("paper") or {}).get("success_once")
+                row.append(f"{fmt.num(paper['value'])} ({paper['source']})" if paper else "—")
                 rows.append(row)
             w(f"### {t} / {s}")
             w("")
-            w(markdown(["method"] + [f"seed {training_seed(b)}" for b in backbones[t]], rows))
+            w(markdown(["method"] + [f"seed {training_seed(b)}" for b in backbones[t]] + ["paper (its PPO)"], rows))
             w("")
     w("## Findings across backbones")
     w("")
