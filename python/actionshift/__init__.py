@@ -457,7 +457,8 @@ def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, c
 
 def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,
              out="results", backbone=None, pool=None, params=None, rotation="live", profile="maniskill",
-             progress="off", threads=1, policy_version=None, policy_files=None):
+             progress="off", threads=1, policy_version=None, policy_files=None, *, robot=None, packages=None,
+             obs_noise=0.0, calibration=None):
     """Run ``policy`` (a callable obs -> 7 canonical numbers; its ``reset()`` is called at each
     episode start if it has one; or the name of one of the library's backbones, ``"expert"``,
     ``"ppo"``, ``"mlp:DIR"``, as ``actionshift run --backbone`` takes it) as the backbone of one hash-addressed job, in this process,
@@ -487,6 +488,12 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     by the library's runner as a user method (docs/methods.md); its records and summary are those of
     a built-in method.
 
+    robot, packages, obs_noise, calibration: as ``make()`` takes them and as ``actionshift run --robot
+    URDF --package NAME=DIR --obs-noise S --calibration FILE`` does: the robot description's content
+    hash, the noise and the calibration's hash enter the job (and its id), so the job is the CLI's.
+    ``calibration`` (a dict as ``calibrate --json`` writes it, or its file) is for a method that uses
+    one, instead of the task's built-in calibration.
+
     Identity (docs/methods.md): a Python policy enters the job id by its content (its code, closure
     and global values, its attributes, ``policy_files``), so two different callables never share a
     job; ``policy_version="..."`` names it instead of its code (for a policy whose content cannot be
@@ -510,6 +517,8 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     if pool is not None and not isinstance(pool, (str, _os.PathLike)):
         raise TypeError(f"evaluate: pool: expected a pool name or manifest path (a job records its pool by hash, "
                         f"and the path of a file; got {type(pool).__name__})")
+    if not isinstance(obs_noise, (int, float, _np.floating, _np.integer)) or isinstance(obs_noise, bool):
+        raise TypeError(f"evaluate: obs_noise: expected a number (got {type(obs_noise).__name__})")
     for name, value, lo, hi, why in (("episodes", episodes, 1, 2 ** 62, "must be > 0 and at most 2**62"),
                                      ("threads", threads, 0, 4096, "must be 0 (all cores) or a count up to 4096")):
         if not isinstance(value, (int, _np.integer)) or isinstance(value, bool):
@@ -540,7 +549,8 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     return _native._evaluate(policy, task, split, method, int(seed), int(episodes), _os.fspath(out), backbone,
                              None if pool is None else _os.fspath(pool),
                              params, rotation, profile, progress, int(threads), method_object, method_identity,
-                             backbone_sha256)
+                             backbone_sha256, _robot_arg(robot), _packages_args("evaluate", packages), float(obs_noise),
+                             calibration)
 
 
 def _json_lines(fin):

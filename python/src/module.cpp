@@ -934,9 +934,9 @@ void write_frames(const std::string& path, py::handle frames, int delay_cs, int 
   render::write_gif(path, images, delay_cs);
 }
 
-// make(calibration=...): a response calibration (a dict as `calibrate --json` writes it, or its file)
-// measured for this task on this profile; returned as its canonical dict
-py::object load_calibration(py::handle calibration, const std::string& task, const std::string& profile) {
+// make(calibration=...) and evaluate(calibration=...): a response calibration (a dict as `calibrate
+// --json` writes it, or its file) measured for this task on this profile
+adapt::ResponseCalibration resolve_calibration(py::handle calibration, const std::string& task, const std::string& profile) {
   const std::string t(sim::task_name(sim::parse_task(task)));
   adapt::ResponseCalibration cal;
   if (py::isinstance<py::dict>(calibration)) {
@@ -948,7 +948,12 @@ py::object load_calibration(py::handle calibration, const std::string& task, con
     const std::string path = py::str(py::module_::import("os").attr("fspath")(calibration)).cast<std::string>();
     cal = adapt::ResponseCalibration::load_for(path, t, "the environment's " + t, profile, "the environment's " + profile);
   }
-  return json_to_py(cal.to_json());
+  return cal;
+}
+
+// ... returned as its canonical dict (env.calibration)
+py::object load_calibration(py::handle calibration, const std::string& task, const std::string& profile) {
+  return json_to_py(resolve_calibration(calibration, task, profile).to_json());
 }
 
 // The C++ baseline of the per-step benchmark (tests/bench/python_bench.py): the same control loop
@@ -1242,7 +1247,8 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
                   std::uint64_t seed, std::int64_t episodes, const std::string& out, const std::string& backbone,
                   std::optional<std::string> pool, py::object params, const std::string& rotation,
                   const std::string& profile, const std::string& progress, int threads, py::object method_object,
-                  py::object method_identity, std::optional<std::string> backbone_sha256) {
+                  py::object method_identity, std::optional<std::string> backbone_sha256, std::optional<std::string> robot,
+                  const std::vector<std::string>& packages, double obs_noise, py::object calibration) {
   // a string names a backbone of the library (expert, mlp:..., ppo:..., external:...), as `run --backbone`
   const bool builtin_backbone = py::isinstance<py::str>(policy);
   if (!builtin_backbone && !PyCallable_Check(policy.ptr()))
@@ -1260,7 +1266,14 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.rotation_mode = rotation;
   q.seed = seed;
   q.episodes = episodes;
+  q.obs_noise = obs_noise;
   q.source = "evaluate";
+  if (!(obs_noise >= 0.0 && obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
+    std::ostringstream got;
+    got << obs_noise;
+    throw InputError("evaluate", "obs_noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
+  }
+  if (!robot && !packages.empty()) throw InputError("evaluate", "packages", "need robot= (a URDF file)");
   eval::PlanResolver resolver = eval::default_resolver();
   if (builtin_backbone) resolver.backbone = eval::default_resolver().backbone;  // the CLI's identity
   else resolver.backbone = [&backbone_sha256](const std::string& t, const std::string& name) {
@@ -1278,7 +1291,20 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
     method_registration = register_python_method(method_object, method_identity.cast<py::dict>(), workers);
     q.method.name = method_registration.name();
   }
-  const eval::JobSpec job = eval::resolve_job(q, resolver);
+  eval::JobSpec job = eval::resolve_job(q, resolver);
+  // as run --robot/--package and --calibration: the robot's content hash and the calibration's hash
+  // enter the job (and its id)
+  if (robot) {
+    const sim::RobotSource r = sim::load_robot_source(*robot, sim::parse_package_args(packages));
+    job.robot = eval::RobotRef{r.sha256, r.urdf, r.packages};
+  }
+  eval::EpisodeFnOptions fn_options;
+  if (!calibration.is_none()) {
+    if (!job.calibration_sha256) throw InputError("evaluate", "calibration", "method " + job.method + " uses no response calibration");
+    fn_options.calibration = resolve_calibration(calibration, task, profile);
+    fn_options.calibration_source = py::isinstance<py::dict>(calibration) ? "calibration" : py::str(calibration).cast<std::string>();
+    job.calibration_sha256 = fn_options.calibration->sha256();
+  }
   if (workers > 1 && !builtin_backbone) {
     try {
       deepcopy(policy);
@@ -1312,7 +1338,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   eval::RunResult r;
   bool interrupted = false;
   {
-    const eval::EpisodeFn fn = eval::make_episode_fn(job, prototype);
+    const eval::EpisodeFn fn = eval::make_episode_fn(job, prototype, fn_options);
     py::gil_scoped_release release;
     try {
       r = eval::run_job(job, fn, ro);
@@ -1862,7 +1888,9 @@ PYBIND11_MODULE(_native, m) {
   m.def("_evaluate", &evaluate, py::arg("policy"), py::arg("task"), py::arg("split"), py::arg("method"), py::arg("seed"),
         py::arg("episodes"), py::arg("out"), py::arg("backbone"), py::arg("pool"), py::arg("params"),
         py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"), py::arg("method_object") = py::none(),
-        py::arg("method_identity") = py::none(), py::arg("backbone_sha256") = py::none());
+        py::arg("method_identity") = py::none(), py::arg("backbone_sha256") = py::none(),
+        py::arg("robot") = py::none(), py::arg("packages") = std::vector<std::string>{}, py::arg("obs_noise") = 0.0,
+        py::arg("calibration") = py::none());
   m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec, "job")), "job")); },
         py::arg("job"));
 

@@ -389,4 +389,9 @@ EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Poli
   return build_episode_fn(job, std::move(backbone), std::move(hooks), std::nullopt);
 }
 
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, const EpisodeFnOptions& options,
+                          EpisodeHooks hooks) {
+  return build_episode_fn(job, std::move(backbone), std::move(hooks), options.calibration, options.calibration_source);
+}
+
 }  // namespace actionshift::eval

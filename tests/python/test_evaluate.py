@@ -179,3 +179,43 @@ def test_ctrl_c_stops_evaluate_and_the_job_resumes(tmp_path, threads):
     r = actionshift.evaluate(lambda obs: np.zeros(7), seed=4, episodes=300, out=str(tmp_path / "x"),
                              threads=threads, backbone="python:zero", policy_version="zero-1")
     assert r["episodes_before"] == kept and r["episodes_run"] == 300 - kept
+
+
+def test_robot_noise_and_calibration_make_the_clis_job(tmp_path, cli, source_dir):
+    # evaluate(robot=, obs_noise=, calibration=) is `run --robot --obs-noise --calibration`: the same job
+    # id and the same records, and each option changes the job it names
+    urdf = os.path.join(source_dir, "configs", "robots", "panda.urdf")
+    cal = json.loads(open(os.path.join(source_dir, "configs", "calibration", "maniskill", "pick_cube.json")).read())
+    cal["sigma"] = [s * 1.5 for s in cal["sigma"]]  # a calibration that is not the built-in one
+    cal_file = tmp_path / "cal.json"
+    cal_file.write_text(json.dumps(cal))
+    common = dict(task="pick_cube", split="seen", method="entropy_probes", pool="reference9", seed=7, episodes=2)
+    plain = actionshift.evaluate("expert", out=str(tmp_path / "plain"), **common)
+    r = actionshift.evaluate("expert", out=str(tmp_path / "py"), robot=urdf, obs_noise=0.002, calibration=cal_file,
+                             **common)
+    job = r["job"]
+    assert job["robot"]["sha256"] == actionshift.make("pick_cube", robot=urdf).robot_sha256
+    assert job["obs_noise"] == 0.002 and job["calibration_sha256"] != plain["job"]["calibration_sha256"]
+    assert r["job_id"] != plain["job_id"]
+    out = cli("run", "--task", "pick_cube", "--split", "seen", "--method", "entropy_probes", "--pool", "reference9",
+              "--seed", "7", "--episodes", "2", "--backbone", "expert", "--robot", urdf, "--obs-noise", "0.002",
+              "--calibration", str(cal_file), "--out", str(tmp_path / "cli"), "--progress", "off", check=0).stdout
+    assert out.startswith(r["job_id"] + " ")
+    assert (tmp_path / "py" / f"{r['job_id']}.jsonl").read_bytes() == \
+        (tmp_path / "cli" / f"{r['job_id']}.jsonl").read_bytes()
+    # a calibration given as a dict is the same job as its file
+    d = actionshift.evaluate("expert", out=str(tmp_path / "dict"), robot=urdf, obs_noise=0.002, calibration=cal, **common)
+    assert d["job_id"] == r["job_id"]
+    # bad values: one-line errors naming the argument
+    for kwargs, match in ((dict(obs_noise=float("nan")), "obs_noise: must be a finite sigma"),
+                          (dict(obs_noise=0.5), "obs_noise: must be a finite sigma"),
+                          (dict(packages={"x": str(tmp_path)}), "packages: need robot="),
+                          (dict(robot=str(tmp_path / "none.urdf")), "none.urdf")):
+        with pytest.raises(ValueError, match=match) as e:
+            actionshift.evaluate("expert", out=str(tmp_path / "bad"), **common, **kwargs)
+        assert "\n" not in str(e.value)
+    with pytest.raises(ValueError, match="calibration: method no_adapt uses no response calibration"):
+        actionshift.evaluate("expert", out=str(tmp_path / "bad"), episodes=1, calibration=cal_file)
+    with pytest.raises(TypeError, match="obs_noise: expected a number"):
+        actionshift.evaluate("expert", out=str(tmp_path / "bad"), episodes=1, obs_noise="0.1")
+    assert not (tmp_path / "bad").exists() or not any((tmp_path / "bad").iterdir())

@@ -119,5 +119,9 @@ inline EpisodeFn make_episode_fn(const JobSpec& job, EpisodeHooks hooks) {
 /// sha256() must equal the spec's backbone (InputError otherwise); each runner worker uses its own
 /// `backbone->clone()`.
 EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, EpisodeHooks hooks = {});
+/// The same with a given response calibration (`options.calibration`, as run --calibration; the other
+/// options concern a backbone resolved by name and are not used).
+EpisodeFn make_episode_fn(const JobSpec& job, std::shared_ptr<const policy::Policy> backbone, const EpisodeFnOptions& options,
+                          EpisodeHooks hooks = {});
 
 }  // namespace actionshift::eval
