@@ -9,6 +9,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import fmt, provenance  # noqa: E402
+from pages.backbones import rung_key, training_seed  # noqa: E402
 from pages.table import markdown  # noqa: E402
 
 PAPER_PAIRS = ["oracle vs no_adapt", "entropy_probes vs no_adapt", "entropy_probes vs fixed_probes",
@@ -16,23 +17,6 @@ PAPER_PAIRS = ["oracle vs no_adapt", "entropy_probes vs no_adapt", "entropy_prob
                "entropy_probes vs grammar_belief{probe=hold}", "grammar_belief{probe=hold} vs grammar_belief"]
 VERDICT_TEXT = {"holds_on_every_backbone": "holds on every backbone", "holds_on_average": "holds on average",
                 "depends_on_backbone": "depends on the backbone", "not_shown": "not shown"}
-
-
-def training_seed(backbone):
-    """The committed `ppo` file is the replica of training seed 20260718; a replica names its seed."""
-    if backbone == "ppo":
-        return "20260718 (committed)"
-    stem = os.path.basename(backbone)
-    return stem.split(".seed")[1].split(".")[0] if ".seed" in stem else backbone
-
-
-RUNGS = ["no_adapt", "grammar_belief", "fixed_probes", "random_probes", "entropy_probes", "exact_belief", "dualabi", "oracle"]
-
-
-def rung_key(label):
-    """The ladder's order (the paper's Fig. 4 bottom to top), a variant after its base."""
-    base = label.split("{")[0]
-    return (RUNGS.index(base) if base in RUNGS else len(RUNGS), label)
 
 
 def short_reason(reason, backbones):

@@ -6,7 +6,9 @@ compared separately and merged here only for layout). Layout only: every rate, W
 probe cost, paired difference and promotion verdict is compare's; the paper's numbers are compare's paper fields
 or configs/paper/numbers.json by id. Per-contract rates come from compare's `per_contract` cell field when the
 compare that wrote the JSON has it.
-usage: scripts/ladder_report.py RESULTS_DIR COMPARE_DIR [--commit C --command CMD --wall S --cores N --cpu TIMES]"""
+With --learned COMPARE_JSON (the comparison of scripts/backbone_variance), a section lays the same rungs
+on the learned PPO backbones (the committed file and its replicas) beside this page's scripted expert.
+usage: scripts/ladder_report.py RESULTS_DIR COMPARE_DIR [--learned JSON] [--commit C --command CMD --wall S --cores N --cpu TIMES]"""
 import json
 import os
 import re
@@ -14,6 +16,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import findings, fmt, paper, provenance, table  # noqa: E402
+from pages.backbones import rung_key, training_seed  # noqa: E402
 from pages.ladder_util import (PER_CONTRACT_MISSING, Groups, contract_class, contract_rate, describe, entry_text,  # noqa: E402
                                has_per_contract, manifest_contracts, paper_ids, per_contract_table)
 from pages.rest_util import ROOT, commit_of, cpu_text, parser, rel, scalar  # noqa: E402
@@ -181,10 +184,49 @@ def evidence_row(G, ev):
     return [what, fmt.cmp_rates(x), fmt.cmp_diff(x), fmt.per_seed_diff(x), findings.bold(st), why]
 
 
+def learned_section(w, G, path, command):
+    """The rungs of the learned backbones' comparison, one column per PPO backbone, beside this page's expert."""
+    with open(path) as f:
+        cells = json.load(f)["cells"]
+    tasks = sorted({c["task"] for c in cells})
+    w("## The ladder on learned backbones, beside the expert's\n")
+    w(f"The same rungs with the task's PPO backbones instead of the scripted expert: the committed file (training seed "
+      f"20260718) and the replicas trained by its recipe with other training seeds, each with the pool `reference9` "
+      f"(`{command}`, {fmt.thousands(sum(c['episodes'] for c in cells))} episodes; per-backbone effects, pooled "
+      f"intervals and verdicts: docs/results/backbone_variance.md, which also draws this ladder per backbone). The "
+      f"expert column is this page's cell of the same label (— where this page did not run it: the expert's fixed "
+      f"probes, DualABI and oracle are on docs/results/tournament.md). success_once "
+      f"[Wilson 95 %] over the seeds {', '.join(map(str, sorted({s['seed'] for c in cells for s in c['per_seed']})))}; "
+      f"the paper's number is for its one PPO checkpoint.\n")
+    for t in tasks:
+        backbones = sorted({c["backbone"] for c in cells if c["task"] == t}, key=training_seed)
+        for split in REF_SPLITS:
+            cs = [c for c in cells if c["task"] == t and c["split"] == split]
+            if not cs:
+                continue
+            rows = []
+            for m in sorted({c["method"] for c in cs}, key=rung_key):
+                e = G.cell("live", t, split, m) if t in TASKS else None
+                row = [f"`{m}`", fmt.cell_rate(e) if e else fmt.DASH]
+                pap = None
+                for b in backbones:
+                    c = next((c for c in cs if c["method"] == m and c["backbone"] == b), None)
+                    row.append(fmt.cell_rate(c) if c else fmt.DASH)
+                    pap = pap or ((c or {}).get("paper") or {}).get("success_once")
+                row.append(f"{fmt.num(pap['value'])} ({pap['source']})" if pap else fmt.DASH)
+                rows.append(row)
+            w(f"### {t} / `{split}`\n")
+            w(table.markdown(["method", "expert"] + [f"PPO seed {training_seed(b)}" for b in backbones] + ["paper (its PPO)"],
+                             rows))
+
+
 def main():
     ap = parser(__doc__)
     ap.add_argument("results")
     ap.add_argument("compare_dir")
+    ap.add_argument("--learned", help="compare JSON of scripts/backbone_variance (the ladder on learned backbones)")
+    ap.add_argument("--learned-command", default="scripts/backbone_variance results/backbone_variance",
+                    help="the command that produced --learned")
     a = ap.parse_args()
     G = Groups(a.compare_dir)
     numbers = paper.load_numbers()
@@ -241,6 +283,8 @@ def main():
         w(t_)
         if missing:
             w("Not run on this split: " + ", ".join(missing) + ".\n")
+    if a.learned:
+        learned_section(w, G, a.learned, a.learned_command)
     w("## Per contract\n")
     w("Each reference split has two contracts (episodes alternate). `reference_seen`: c0 delta, base frame, gripper inverted;"
       " c1 delta, gripper not inverted. `reference_unseen_composition`: c0 absolute, tool frame; c1 absolute, base frame;"

@@ -70,7 +70,11 @@ def page_text(page, binary, tmp):
         for name, dirs, pairs in groups(os.path.join(ROOT, d, "results"), pairs_dir=os.path.join(ROOT, d)):
             compare(binary, [os.path.relpath(x, ROOT) for x in dirs], f"{cdir}/{name}.json",
                     os.path.relpath(pairs, ROOT) if pairs else None, ["--common-episodes"])
-        return py("scripts/ladder_report.py", f"{d}/results", cdir, *PROV, "--command", f"scripts/ladder {d}/results")
+        # the learned-backbone section: the backbone_variance fixture's comparison
+        b = f"{DATA}/backbone_variance"
+        compare(binary, [f"{b}/results"], f"{tmp}/learned.json", "scripts/backbone_variance.pairs", ["--across-backbones"])
+        return py("scripts/ladder_report.py", f"{d}/results", cdir, *PROV, "--command", f"scripts/ladder {d}/results",
+                  "--learned", f"{tmp}/learned.json", "--learned-command", f"scripts/backbone_variance {b}/results")
     raise SystemExit(f"run_page_test: unknown page {page}")
 
 

@@ -1,0 +1,21 @@
+"""Naming and ordering shared by the pages that lay out several PPO backbones of one task (the committed
+file and its independently trained replicas): docs/results/backbone_variance.md and the learned-backbone
+section of docs/results/ladder.md."""
+import os
+
+# the ladder's order (the paper's Fig. 4, bottom to top)
+RUNGS = ["no_adapt", "grammar_belief", "fixed_probes", "random_probes", "entropy_probes", "exact_belief", "dualabi", "oracle"]
+
+
+def training_seed(backbone):
+    """The committed `ppo` file is the replica of training seed 20260718; a replica names its seed."""
+    if backbone == "ppo":
+        return "20260718 (committed)"
+    stem = os.path.basename(backbone)
+    return stem.split(".seed")[1].split(".")[0] if ".seed" in stem else backbone
+
+
+def rung_key(label):
+    """The ladder's order of a method label, a variant after its base."""
+    base = label.split("{")[0]
+    return (RUNGS.index(base) if base in RUNGS else len(RUNGS), label)
