@@ -9,15 +9,8 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import fmt, provenance  # noqa: E402
-from pages.backbones import rung_key, training_seed  # noqa: E402
+from pages.backbones import PAPER_PAIRS, VERDICT_TEXT, diff_text, rung_key, training_seed  # noqa: E402
 from pages.table import markdown  # noqa: E402
-
-PAPER_PAIRS = ["oracle vs no_adapt", "entropy_probes vs no_adapt", "entropy_probes vs fixed_probes",
-               "dualabi vs entropy_probes", "oracle vs entropy_probes", "grammar_belief{probe=hold} vs no_adapt",
-               "entropy_probes vs grammar_belief{probe=hold}", "grammar_belief{probe=hold} vs grammar_belief"]
-VERDICT_TEXT = {"holds_on_every_backbone": "holds on every backbone", "holds_on_average": "holds on average",
-                "depends_on_backbone": "depends on the backbone", "not_shown": "not shown"}
-
 
 def short_reason(reason, backbones):
     """The verdict's reason with each backbone named by its training seed."""
@@ -39,11 +32,6 @@ def competence(cell):
         return "—"
     i = cell["competence"]["interval"]
     return f"{i['successes']}/{i['total']} = {fmt.num(i['rate'])} [{fmt.num(i['lower'])}, {fmt.num(i['upper'])}] ({cell['decision']})"
-
-
-def diff_text(d):
-    mark = "**" if d["direction"] != "none" else ""
-    return f"{mark}{fmt.signed(d['estimate'])} [{fmt.signed(d['lower'])}, {fmt.signed(d['upper'])}]{mark}"
 
 
 def main():

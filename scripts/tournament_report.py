@@ -5,7 +5,9 @@ scripts/pages/tournament.pairs. Both probe rules side by side (the paper's: bare
 `{calibrated}`), every paper finding with its status, the probe-displacement explanation, per-split cell tables
 and the promotion audit. No statistics here.
 usage: scripts/tournament_report.py --compare FILE --commit SHA --command TEXT [--wall S] [--cores N]
-       [--displacement FILE] [--numbers FILE]"""
+       [--displacement FILE] [--numbers FILE] [--across FILE]
+--across: the comparison of scripts/backbone_variance (compare --across-backbones); its verdicts on the paper's
+findings over independently trained PPO backbones are summarised here (the full page: backbone_variance.md)."""
 import argparse
 import json
 import os
@@ -13,6 +15,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import findings, fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
+from pages import backbones as backbones_page  # noqa: E402
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--compare", required=True)
@@ -22,6 +25,7 @@ ap.add_argument("--wall")
 ap.add_argument("--cores")
 ap.add_argument("--displacement", help="optional JSON {summary, rows} on the cause of the probe displacement")
 ap.add_argument("--numbers", default=paper.NUMBERS)
+ap.add_argument("--across", help="compare --across-backbones JSON of scripts/backbone_variance (optional)")
 a = ap.parse_args()
 
 c = load_comparison(a.compare)
@@ -51,6 +55,31 @@ out.append(sections.headline_table(c, backbones))
 # ---- findings
 out.append("\n## The paper's findings, tested\n\n" + sections.STATUS_RULE + "\n\n")
 out.append(sections.findings_table(c, numbers, backbones))
+if a.across:
+    with open(a.across) as f:
+        across = json.load(f).get("across_backbones") or []
+    out.append("\n### Across independently trained backbones\n\n")
+    out.append("The paper's findings on the PPO backbones of a task (the committed file and the replicas trained by its "
+               "recipe with other training seeds): the pooled difference by a hierarchical bootstrap over backbones, "
+               "seeds and blocks, and whether it holds on every backbone, on average, or depends on the backbone "
+               "(per-backbone effects and the project's own variants: [backbone_variance.md](backbone_variance.md)).\n\n")
+    def paper_text(x):
+        # the paper's paired difference where it prints one, else its two cell rates (its one PPO checkpoint)
+        e, rev = numbers.find_difference(x["task"], x["split"], x["candidate"], x["baseline"], "ppo")
+        if e:
+            return f"{paper.entry_diff_value(e, rev)} ({paper.source(e)})"
+        cells = [numbers.find_cell("success_once", x["task"], x["split"], m, "ppo") for m in (x["candidate"], x["baseline"])]
+        if all(cells):
+            srcs = list(dict.fromkeys(paper.source(e) for e in cells))
+            return " / ".join(fmt.num(e["value"]) for e in cells) + f" ({' / '.join(srcs)})"
+        return fmt.DASH
+
+    rows = [[f"`{x['candidate']}` − `{x['baseline']}`", x["task"], x["split"], str(len(x["backbones"])),
+             backbones_page.diff_text(x["pooled"]), f"**{backbones_page.VERDICT_TEXT[x['verdict']]}**", paper_text(x)]
+            for x in across if f"{x['candidate']} vs {x['baseline']}" in backbones_page.PAPER_PAIRS]
+    out.append(table.markdown(["paper's pair", "task", "split", "backbones", "pooled difference [95 %]", "verdict",
+                               "paper (its PPO: difference, or candidate / baseline rates)"], rows)
+               if rows else "No paper pair in the across-backbones comparison.\n")
 out.append("\nProbe cost (the paper's §5.5: DualABI probes less than entropy probing). Compare gives mean probe steps and "
            "displacement per cell, no interval for their difference, so this is descriptive:\n\n")
 rows = []

@@ -3,6 +3,8 @@ file and its independently trained replicas): docs/results/backbone_variance.md 
 section of docs/results/ladder.md."""
 import os
 
+from . import fmt
+
 # the ladder's order (the paper's Fig. 4, bottom to top)
 RUNGS = ["no_adapt", "grammar_belief", "fixed_probes", "random_probes", "entropy_probes", "exact_belief", "dualabi", "oracle"]
 
@@ -19,3 +21,17 @@ def rung_key(label):
     """The ladder's order of a method label, a variant after its base."""
     base = label.split("{")[0]
     return (RUNGS.index(base) if base in RUNGS else len(RUNGS), label)
+
+
+# the paper's findings (its methods, its probe rule) among the across-backbones pairs (scripts/backbone_variance.pairs)
+PAPER_PAIRS = ["oracle vs no_adapt", "entropy_probes vs no_adapt", "entropy_probes vs fixed_probes",
+               "dualabi vs entropy_probes", "oracle vs entropy_probes", "grammar_belief{probe=hold} vs no_adapt",
+               "entropy_probes vs grammar_belief{probe=hold}", "grammar_belief{probe=hold} vs grammar_belief"]
+VERDICT_TEXT = {"holds_on_every_backbone": "holds on every backbone", "holds_on_average": "holds on average",
+                "depends_on_backbone": "depends on the backbone", "not_shown": "not shown"}
+
+
+def diff_text(d):
+    """A difference [interval] of compare, bold where the interval excludes 0."""
+    mark = "**" if d["direction"] != "none" else ""
+    return f"{mark}{fmt.signed(d['estimate'])} [{fmt.signed(d['lower'])}, {fmt.signed(d['upper'])}]{mark}"

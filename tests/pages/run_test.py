@@ -47,8 +47,11 @@ if a.page == "gate1":
                 "--verdict", gate1_verdict("gate1", f"{D}/gate1"), "--command", f"scripts/gate1 {D}/gate1", *FIXED])
 elif a.page == "tournament":
     dirs = [f"{D}/tournament", f"{D}/learned_backbone_ppo/tournament_ppo"]
+    across = os.path.join(tmp, "across.json")  # the across-backbones summary: the backbone_variance fixture
+    run([binary, "compare", f"{D}/backbone_variance/results", "--pairs-from", "scripts/backbone_variance.pairs",
+         "--across-backbones", "--out", across])
     page = run([sys.executable, "scripts/tournament_report.py", "--compare", compare("tournament", dirs, "scripts/pages/tournament.pairs"),
-                "--displacement", "tests/pages/displacement.json",
+                "--displacement", "tests/pages/displacement.json", "--across", across,
                 "--command", f"PPO_RESULTS={dirs[1]} scripts/tournament {dirs[0]}", *FIXED])
 else:
     L = "ppo" if a.page == "learned_backbone_ppo" else "mlp"
