@@ -46,6 +46,7 @@ from ._native import (  # noqa: F401  (re-exported API)
     tasks,
     tcp_response,
     tcp_rotation,
+    wilson_interval,
 )
 
 __version__ = _native.__version__
@@ -59,7 +60,7 @@ __all__ = [
     "make_adapter", "make_vec", "method_label", "method_needs_calibration", "method_needs_pool", "method_params",
     "method_rung", "PoolBelief", "ResponseModel",
     "method_variants", "methods", "pool_sha256", "selftest_library", "selftest_sim_options", "serve_method", "serve_policy", "tasks", "tcp_response", "tcp_rotation",
-    "write_frames",
+    "wilson_interval", "write_frames",
 ]
 
 PROFILES = ("maniskill", "ideal")

@@ -6,6 +6,7 @@
 #include "actionshift/adapt/pool_belief.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/response.hpp"
+#include "actionshift/core/wilson.hpp"
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
@@ -1758,6 +1759,25 @@ PYBIND11_MODULE(_native, m) {
   m.def("_load_calibration", &load_calibration, py::arg("calibration"), py::arg("task"), py::arg("profile"));
   m.attr("__version__") = eval::build_provenance().version;
   m.attr("__git_commit__") = eval::build_provenance().git_commit.empty() ? py::object(py::none()) : py::object(py::str(eval::build_provenance().git_commit));
+  // the statistics engine's Wilson score interval (core/wilson.hpp), for pages laid out in Python
+  m.def(
+      "wilson_interval",
+      [](std::int64_t successes, std::int64_t total) {
+        if (total <= 0 || successes < 0 || successes > total)
+          value_error("wilson_interval: need 0 <= successes <= total and total > 0 (got " + std::to_string(successes) + " of " +
+                      std::to_string(total) + ")");
+        const WilsonInterval w = wilson_interval(successes, total);
+        py::dict d;
+        d["successes"] = w.successes;
+        d["total"] = w.total;
+        d["rate"] = w.rate;
+        d["lower"] = w.lower;
+        d["upper"] = w.upper;
+        d["confidence"] = w.confidence;
+        return d;
+      },
+      py::arg("successes"), py::arg("total"),
+      "Wilson score 95 % interval of successes/total, as Gate 0 and compare compute it (not clamped).");
   m.def("tasks", [] {
     std::vector<std::string> out;
     for (auto t : sim::all_tasks()) out.emplace_back(sim::task_name(t));

@@ -187,3 +187,14 @@ def test_constructor_calls_that_match_no_signature_are_one_line_type_errors(call
         == actionshift.Contract.identity().hash()
     assert actionshift.Contract(scale=[0.5, 1, 2, 1, 1, 1]).scale == [0.5, 1.0, 2.0, 1.0, 1.0, 1.0]
     assert actionshift.SelfTest(amplitude=1).verdict() == actionshift.SelfTest(amplitude=1.0).verdict()
+
+
+def test_wilson_interval_is_the_engines(cli):
+    # the same numbers as Gate 0's verdict file for the same counts (the reference's 0/600 lower bound is 0.0)
+    w = actionshift.wilson_interval(297, 300)
+    assert w["successes"] == 297 and w["total"] == 300 and abs(w["rate"] - 0.99) < 1e-15
+    assert round(w["lower"], 3) == 0.971 and round(w["upper"], 3) == 0.997
+    assert actionshift.wilson_interval(0, 600)["lower"] == 0.0
+    for bad in ((1, 0), (-1, 5), (6, 5)):
+        with pytest.raises(ValueError, match="wilson_interval"):
+            actionshift.wilson_interval(*bad)
