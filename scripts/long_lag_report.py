@@ -149,7 +149,7 @@ def probe_claim_status(dr, dd, rb, db, printed=None):
     if premise and shown:
         strict = "excludes 0, entropy above" if b["lower"] > 0 else "lower bound 0: entropy at least fixed"
         return "reproduced", f"{premise}; {txt_d} ({strict})"
-    missing = []
+    missing = [] if not premise else [f"the reactive premise holds ({premise})"]
     if not premise:
         missing.append(f"the reactive premise is not shown ({txt_r}"
                        + (f"; the paper printed fixed − entropy {fmt.signed(printed)})" if printed is not None else ")"))

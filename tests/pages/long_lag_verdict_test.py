@@ -27,6 +27,7 @@ CASES = [
     (cmp(0.05, 0.01, 0.09), cmp(0.05, 0.01, 0.09), 0.115, "contradicted", "the reactive premise (fixed above entropy) fails"),
     (cmp(-0.10, -0.15, -0.05), cmp(-0.05, -0.09, -0.01), 0.115, "contradicted", "fixed still above"),
     (cmp(-0.10, -0.15, -0.05), cmp(0.01, -0.03, 0.05), None, "inconclusive", "includes 0"),
+    (cmp(-0.015, -0.035, 0.007), cmp(0.01, -0.02, 0.04), 0.012, "inconclusive", "the reactive premise holds (on `ppo`"),
     (cmp(-0.10, -0.15, -0.05), cmp(0.0, 0.0, 0.0), None, "inconclusive", "no episode differs"),
     (None, cmp(0.05, 0.01, 0.09), None, "untestable", "`ppo`"),
 ]
