@@ -40,8 +40,22 @@ for page in $PAGES; do
       run --task pick_cube --split reference_long_lag --method oracle --backbone "$b" --out "$D/$page/results"
       run --task pick_cube --split reference_long_lag --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
     done
+    # the probing section: fixed and entropy probing on a reactive / delay-aware pair of each kind (expert: the
+    # extension rows; ppo: the paper's claim with its Table 5 numbers), the `{calibrated}` variant and DualABI on the PPO pair
+    for b in expert expert-delay-aware ppo ppo-delay-aware; do
+      for m in fixed_probes entropy_probes; do
+        run --task pick_cube --split reference_long_lag --method "$m" --pool reference9 --backbone "$b" --out "$D/$page/results"
+      done
+    done
+    for b in ppo ppo-delay-aware; do
+      for m in 'entropy_probes{calibrated}' dualabi; do
+        run --task pick_cube --split reference_long_lag --method "$m" --pool reference9 --backbone "$b" --out "$D/$page/results"
+      done
+    done
     printf '%s\n' 'oracle@expert-delay-aware vs oracle@expert' 'exact_belief@expert-delay-aware vs exact_belief@expert' \
-        > "$D/$page/pairs.txt" ;;
+        'fixed_probes@ppo-delay-aware vs fixed_probes@ppo' 'entropy_probes@ppo-delay-aware vs entropy_probes@ppo' \
+        'entropy_probes{calibrated}@ppo-delay-aware vs entropy_probes{calibrated}@ppo' \
+        'entropy_probes vs fixed_probes' 'entropy_probes{calibrated} vs fixed_probes' > "$D/$page/pairs.txt" ;;
   noise_sensitivity)
     for mm in 0 20; do
       d="$D/$page/results/sigma_${mm}mm"; mkdir -p "$d/matched"

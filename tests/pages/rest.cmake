@@ -16,3 +16,9 @@ if(Python3_Interpreter_FOUND)
            COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/ladder_per_contract_test.py $<TARGET_FILE:actionshift>)
   set_tests_properties(pages.ladder_per_contract PROPERTIES LABELS pages TIMEOUT 120)
 endif()
+if(Python3_Interpreter_FOUND)
+  # the long-lag page's verdict rule (fixed vs entropy probing, reactive vs delay-aware), every branch on made-up differences
+  add_test(NAME pages.long_lag_verdict
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/long_lag_verdict_test.py)
+  set_tests_properties(pages.long_lag_verdict PROPERTIES LABELS pages TIMEOUT 60)
+endif()
