@@ -78,8 +78,10 @@ def main():
     w("- Verdicts: **holds on every backbone** (the pooled interval and each backbone's exclude 0 with one sign), "
       "**holds on average** (the pooled one does, some backbone's does not), **depends on the backbone** (backbones "
       "significant with opposite signs, or shown on some backbones while the pooled interval includes 0), **not shown**.")
-    w("- Not here: pick_cube and stack_cube (their recipes were not replicated this round: docs/backbones.md), the learned "
-      "identifiers (trained for pick_cube only) and the probing methods on the delay-aware backbones.")
+    w("- Not here: pick_cube (its two-stage recipe's replicas have a committed adoption rule and script, "
+      "`scripts/backbone_replicas_pick`, but are not trained yet: docs/backbones.md) and stack_cube (its recipe starts from a "
+      "weak imitation network and is not replicated), and so the learned identifiers (trained for pick_cube only). The "
+      "probing methods on the delay-aware backbones under lag are on docs/results/long_lag.md.")
     w("")
     w("## The backbones (Gate 0, 300 episodes)")
     w("")
