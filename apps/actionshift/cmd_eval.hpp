@@ -4,7 +4,7 @@
 // (after printing one line `actionshift: error: ...` to `err`).
 
 #include "actionshift/eval/job.hpp"
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/plan_expand.hpp"
 #include "actionshift/eval/runner.hpp"
 
 #include <cstdint>

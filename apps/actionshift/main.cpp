@@ -12,7 +12,7 @@
 #include "commands.hpp"
 
 #include "actionshift/adapt/registry.hpp"
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/slurm.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/sim/env.hpp"
 
