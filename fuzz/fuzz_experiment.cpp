@@ -1,5 +1,5 @@
 // experiment YAML (eval::parse_experiment)
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/experiment_yaml.hpp"
 #include "harness.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,7 +1,8 @@
 // plan files (the JSON of `actionshift plan`, read by `run --plan`): parse_json_input + plan_from_json
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/job.hpp"
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/plan_io.hpp"
 #include "harness.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -5,7 +5,7 @@ delay-aware PPO backbone see in its history meanwhile? (diagnostic; docs/results
 Runs an `.asmlp` backbone, evaluated in numpy exactly as the C++ MlpPolicy evaluates it
 (float32, tanh hidden layers, linear output clipped to [-1, 1]; a delay-aware file gets its own
 last 4 emitted outputs, most recent first, zeros at episode start), through an adapter on the
-contracts of a split, with a Python copy of the runner's episode loop (src/eval/experiment.cpp,
+contracts of a split, with a Python copy of the runner's episode loop (src/eval/episode_fn.cpp,
 Context::run): episode i runs contract deal_permutation(seed, n, i div n)[i mod n] with env seed
 episode_seed(seed, i div n) and adapter seed adapter_episode_seed(seed, i div n); per step: act, R from the observation, encode,
 step, stop on a safety flag, response, observe, stop at the horizon. `--verify` runs the same

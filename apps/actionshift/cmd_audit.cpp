@@ -9,7 +9,7 @@
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/weight_file.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/selftest/audit.hpp"
 #include "actionshift/selftest/audit_hdf5.hpp"

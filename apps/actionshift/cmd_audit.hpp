@@ -1,7 +1,7 @@
 #pragma once
 // `actionshift audit LOG` (issue 37, docs/audit.md): identify the action contract of a recorded log,
 // and `actionshift record`: write such a log from the simulator for any job and contract. Plain
-// functions; main.cpp (the only CLI11 translation unit) fills the structs.
+// functions; cli_selftest.cpp binds the options into the structs.
 // audit exit codes: 0 PASS, 1 MISMATCH, 2 bad input or usage (as the rest of the CLI), 3 INCONCLUSIVE.
 
 #include "cmd_run.hpp"

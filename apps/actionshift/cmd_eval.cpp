@@ -1,18 +1,21 @@
 #include "cmd_eval.hpp"
 
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/experiment_yaml.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/plan_io.hpp"
+#include "actionshift/eval/resolve.hpp"
+#include "actionshift/eval/slurm.hpp"
 
 #include "commands.hpp"
 
+#include "actionshift/adapt/plugin.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
+#include "actionshift/eval/external_method.hpp"
 #include "actionshift/eval/gates.hpp"
-#include "actionshift/eval/plan.hpp"
 #include "actionshift/eval/store.hpp"
 #include "actionshift/eval/summary.hpp"
-#include "actionshift/adapt/plugin.hpp"
-#include "actionshift/eval/external_method.hpp"
 #include "actionshift/policy/external.hpp"
 #include "actionshift/policy/line_process.hpp"
 

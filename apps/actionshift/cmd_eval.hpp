@@ -1,10 +1,10 @@
 #pragma once
-// Evaluation subcommands of the actionshift CLI as plain functions (no CLI11 here): main.cpp maps
-// parsed options onto these structs. Each returns an exit status: 0 ok, 1 check failed, 2 bad input
+// Evaluation subcommands of the actionshift CLI as plain functions (no CLI11 here): cli_eval.cpp binds
+// the parsed options into these structs. Each returns an exit status: 0 ok, 1 check failed, 2 bad input
 // (after printing one line `actionshift: error: ...` to `err`).
 
 #include "actionshift/eval/job.hpp"
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/plan_expand.hpp"
 #include "actionshift/eval/runner.hpp"
 
 #include <cstdint>
@@ -107,7 +107,7 @@ int run_plan_jobs(const RunPlanOptions& options, const EpisodeFnFactory& make_ep
                   std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
 // `actionshift run --task T --split S --method M --seed X ...`: one job already resolved into a spec
-// by main.cpp (with the same resolver as `plan`), run with the options of RunPlanOptions
+// by cmd_run.cpp (with the same resolver as `plan`), run with the options of RunPlanOptions
 // (plan_file and job_index are ignored).
 int run_one_job(const eval::JobSpec& job, const RunPlanOptions& options, const EpisodeFnFactory& make_episode_fn,
                 std::ostream& out = std::cout, std::ostream& err = std::cerr);

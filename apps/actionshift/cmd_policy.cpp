@@ -1,4 +1,5 @@
-// `train bc` and `gate0`: thin wrappers over the policy layer
+// `train bc`, `train ppo` and `gate0`: thin wrappers over the policy layer (their library settings are
+// bound by cli_policy.cpp and checked by the library)
 #include "cmd_policy.hpp"
 
 #include "cmd_eval.hpp"
@@ -51,48 +52,39 @@ std::string hidden_text(const std::vector<int>& widths) {
 
 }  // namespace
 
-int run_train_bc(const TrainBcOptions& o, std::ostream& out, std::ostream& err) {
+int run_train_bc(TrainBcOptions o, std::ostream& out, std::ostream& err) {
   try {
-    policy::TrainBcOptions t;
+    policy::TrainBcOptions& t = o.train;  // --profile (checked while parsing), --seed, --iterations, ...
     t.task = sim::parse_task(o.task);
-    t.delay_aware = o.delay_aware;
-    (void)sim::profile_config(o.profile);  // validates the name
-    t.profile = o.profile;
-    t.seed = o.seed;
-    t.iterations = o.iterations;
-    t.episodes_per_iteration = o.episodes;
-    t.steps_per_iteration = o.steps;
-    t.threads = o.threads;
     t.hidden = parse_hidden(o.hidden);
-    if (o.iterations <= 0 || o.episodes <= 0 || o.steps < 0)
-      throw InputError("", "train bc", "--iterations and --episodes must be positive, --steps non-negative");
-    const std::string backbone = o.delay_aware ? "mlp-delay-aware" : "mlp";
+    policy::check_train_bc_options(t);
+    const std::string backbone = t.delay_aware ? "mlp-delay-aware" : "mlp";
     const std::string path = o.out.empty() ? policy::mlp_weights_path(backbone, t.task) : o.out;
     require_writable_output(path);  // before the DAgger iterations, not after them
-    std::string command = "actionshift train bc --task " + o.task + (o.delay_aware ? " --delay-aware" : "") +
-                          " --seed " + std::to_string(o.seed) + " --iterations " + std::to_string(o.iterations) +
-                          " --episodes " + std::to_string(o.episodes) + " --steps " + std::to_string(o.steps) +
-                          (o.hidden == TrainBcOptions{}.hidden ? "" : " --hidden " + o.hidden) + " --profile " + o.profile;
+    std::string command = "actionshift train bc --task " + o.task + (t.delay_aware ? " --delay-aware" : "") +
+                          " --seed " + std::to_string(t.seed) + " --iterations " + std::to_string(t.iterations) +
+                          " --episodes " + std::to_string(t.episodes_per_iteration) + " --steps " + std::to_string(t.steps_per_iteration) +
+                          (o.hidden == TrainBcOptions{}.hidden ? "" : " --hidden " + o.hidden) + " --profile " + t.profile;
     err << "train bc: " << o.task << " " << backbone << ", layers " << sim::observation_layout(t.task).size() +
-                                                                            (o.delay_aware ? 28 : 0)
-        << "-" << hidden_text(t.hidden) << "-7, " << o.iterations << " DAgger iterations x " << o.episodes << " episodes, seed " << o.seed << "\n";
+                                                                            (t.delay_aware ? 28 : 0)
+        << "-" << hidden_text(t.hidden) << "-7, " << t.iterations << " DAgger iterations x " << t.episodes_per_iteration << " episodes, seed " << t.seed << "\n";
     if (o.progress != "off") (void)parse_progress_mode(o.progress);  // validates the mode
-    auto result = policy::train_bc(t, [&err, &o](const policy::TrainIteration& it) {
+    auto result = policy::train_bc(t, [&err, &o, &t](const policy::TrainIteration& it) {
       if (o.progress == "off") return;
-      err << "  iteration " << it.iteration + 1 << "/" << o.iterations << ": beta " << fmt(it.beta, 3) << ", rollouts "
+      err << "  iteration " << it.iteration + 1 << "/" << t.iterations << ": beta " << fmt(it.beta, 3) << ", rollouts "
           << it.successes << "/" << it.episodes << " success, data " << it.samples << ", loss " << fmt(it.loss, 5)
           << ", " << fmt(it.seconds, 1) << " s\n";
     });
     result.weights.training = {{"command", command},
-                               {"seed", o.seed},
+                               {"seed", t.seed},
                                {"algorithm", "DAgger from the scripted expert, Adam, MSE (gripper weight 2)"},
-                               {"iterations", o.iterations},
-                               {"episodes_per_iteration", o.episodes},
-                               {"steps_per_iteration", o.steps},
+                               {"iterations", t.iterations},
+                               {"episodes_per_iteration", t.episodes_per_iteration},
+                               {"steps_per_iteration", t.steps_per_iteration},
                                {"batch_size", t.batch_size},
                                {"learning_rate", t.learning_rate},
-                               {"teacher", o.delay_aware ? "expert-delay-aware (true lag)" : "expert"},
-                               {"lags", o.delay_aware ? nlohmann::json({0, 1, 2, 4}) : nlohmann::json({0})},
+                               {"teacher", t.delay_aware ? "expert-delay-aware (true lag)" : "expert"},
+                               {"lags", t.delay_aware ? nlohmann::json({0, 1, 2, 4}) : nlohmann::json({0})},
                                {"final_rollout_success", result.iterations.back().successes},
                                {"final_rollout_episodes", result.iterations.back().episodes}};
     if (o.hidden != TrainBcOptions{}.hidden) result.weights.training["hidden"] = t.hidden;  // default: as before
@@ -129,46 +121,13 @@ std::vector<int> parse_hidden(const std::string& text) {
 }
 }  // namespace
 
-int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err) {
+int run_train_ppo(TrainPpoOptions o, std::ostream& out, std::ostream& err) {
   try {
-    policy::PpoOptions p;
+    policy::PpoOptions& p = o.ppo;  // --profile (checked while parsing), --seed, --envs, --lr, ...
     p.task = sim::parse_task(o.task);
-    (void)sim::profile_config(o.profile);  // validates the name
-    p.profile = o.profile;
-    p.seed = o.seed;
     p.hidden = parse_hidden(o.hidden);
-    if (o.total_steps <= 0) throw InputError("", "total-steps", "must be positive");
-    if (o.envs <= 0 || o.envs > 4096) throw InputError("", "envs", "must be in [1, 4096]");
-    if (o.rollout_steps <= 0) throw InputError("", "rollout-steps", "must be positive");
-    if (o.minibatches <= 0 || static_cast<std::int64_t>(o.envs) * o.rollout_steps < o.minibatches)
-      throw InputError("", "minibatches", "must be positive and at most envs x rollout-steps");
-    if (o.epochs <= 0) throw InputError("", "epochs", "must be positive");
-    if (!(o.learning_rate > 0) || !std::isfinite(o.learning_rate)) throw InputError("", "lr", "must be positive");
-    if (!(o.gamma >= 0 && o.gamma <= 1)) throw InputError("", "gamma", "must be in [0, 1]");
-    if (!(o.gae_lambda >= 0 && o.gae_lambda <= 1)) throw InputError("", "gae-lambda", "must be in [0, 1]");
-    if (o.eval_every < 0 || o.eval_episodes < 0) throw InputError("", "eval-every", "--eval-every and --eval-episodes must be non-negative");
-    p.total_steps = o.total_steps;
-    p.num_envs = o.envs;
-    p.num_steps = o.rollout_steps;
-    p.num_minibatches = o.minibatches;
-    p.update_epochs = o.epochs;
-    p.learning_rate = o.learning_rate;
-    p.gamma = o.gamma;
-    p.gae_lambda = o.gae_lambda;
-    p.target_kl = o.target_kl;
-    p.eval_every = o.eval_every;
-    p.eval_episodes = o.eval_episodes;
-    p.threads = o.threads;
-    p.delay_aware = o.delay_aware;
-    p.anneal_lr = o.anneal_lr;
     p.bootstrap_success = !o.terminal_success;
-    if (o.stop_after < 0) throw InputError("", "stop-after", "must be non-negative");
-    p.stop_steps = o.stop_after;
-    if (!std::isfinite(o.init_log_std) || o.init_log_std < -5 || o.init_log_std > 1)
-      throw InputError("", "init-log-std", "must be in [-5, 1]");
-    p.init_log_std = o.init_log_std;
-    if (o.critic_warmup < 0) throw InputError("", "critic-warmup", "must be non-negative");
-    p.critic_warmup = o.critic_warmup;
+    policy::check_ppo_options(p);
     std::string init_sha;
     if (!o.init_from.empty()) {
       const auto init = policy::MlpPolicy::from_file(o.init_from);
@@ -177,14 +136,14 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
         throw InputError(o.init_from, "task", "is " + std::string(sim::task_name(w->task)) + ", the run trains " + o.task);
       const std::vector<int> hidden(w->layers.begin() + 1, w->layers.end() - 1);
       if (hidden != p.hidden) throw InputError(o.init_from, "layers", "hidden widths differ from --hidden " + o.hidden);
-      if (w->history != 0 && !o.delay_aware)
+      if (w->history != 0 && !p.delay_aware)
         throw InputError(o.init_from, "history", "a delay-aware network cannot start a reactive run (add --delay-aware)");
       init_sha = init->sha256();
       p.init_actor = std::move(w);
     }
     const eval::ProgressMode mode = parse_progress_mode(o.progress);
     const bool bar = mode == eval::ProgressMode::bar || (mode == eval::ProgressMode::automatic && isatty(2));
-    const std::string path = o.out.empty() ? policy::mlp_weights_path(o.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
+    const std::string path = o.out.empty() ? policy::mlp_weights_path(p.delay_aware ? "ppo-delay-aware" : "ppo", p.task) : o.out;
     require_writable_output(path);  // before the run, not after it
     const std::string stem = path.size() > 6 && path.ends_with(".asmlp") ? path.substr(0, path.size() - 6) : path;
     const std::string curve_path = o.curve.empty() ? stem + ".curve.jsonl" : o.curve;
@@ -193,57 +152,57 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
     // the command that reproduces a run of `steps` environment steps (a checkpoint names its own): the
     // total steps themselves, or, when the learning-rate schedule depends on the total (--anneal-lr),
     // the same total and --stop-after
-    const std::int64_t full_steps = std::max<std::int64_t>(1, o.total_steps / (static_cast<std::int64_t>(o.envs) * o.rollout_steps)) *
-                                    o.envs * o.rollout_steps;
-    auto command = [&o, full_steps](std::int64_t steps) {
+    const std::int64_t full_steps = std::max<std::int64_t>(1, p.total_steps / (static_cast<std::int64_t>(p.num_envs) * p.num_steps)) *
+                                    p.num_envs * p.num_steps;
+    auto command = [&o, &p, full_steps](std::int64_t steps) {
       std::ostringstream cmd;
-      cmd << "actionshift train ppo --task " << o.task << " --profile " << o.profile << " --seed " << o.seed << " --total-steps "
-          << (o.anneal_lr ? o.total_steps : steps) << " --envs " << o.envs << " --rollout-steps " << o.rollout_steps << " --minibatches " << o.minibatches
-          << " --epochs " << o.epochs << " --lr " << o.learning_rate << " --gamma " << o.gamma << " --gae-lambda " << o.gae_lambda
-          << " --target-kl " << o.target_kl << " --hidden " << o.hidden << " --eval-every " << o.eval_every
-          << " --eval-episodes " << o.eval_episodes;
-      if (o.delay_aware) cmd << " --delay-aware";
-      if (o.anneal_lr) cmd << " --anneal-lr";
+      cmd << "actionshift train ppo --task " << o.task << " --profile " << p.profile << " --seed " << p.seed << " --total-steps "
+          << (p.anneal_lr ? p.total_steps : steps) << " --envs " << p.num_envs << " --rollout-steps " << p.num_steps << " --minibatches " << p.num_minibatches
+          << " --epochs " << p.update_epochs << " --lr " << p.learning_rate << " --gamma " << p.gamma << " --gae-lambda " << p.gae_lambda
+          << " --target-kl " << p.target_kl << " --hidden " << o.hidden << " --eval-every " << p.eval_every
+          << " --eval-episodes " << p.eval_episodes;
+      if (p.delay_aware) cmd << " --delay-aware";
+      if (p.anneal_lr) cmd << " --anneal-lr";
       if (o.terminal_success) cmd << " --terminal-success";
-      if (o.anneal_lr && steps < full_steps) cmd << " --stop-after " << steps;
+      if (p.anneal_lr && steps < full_steps) cmd << " --stop-after " << steps;
       if (!o.init_from.empty()) cmd << " --init-from " << o.init_from;
-      if (o.init_log_std != -0.5) cmd << " --init-log-std " << o.init_log_std;
-      if (o.critic_warmup > 0) cmd << " --critic-warmup " << o.critic_warmup;
+      if (p.init_log_std != -0.5) cmd << " --init-log-std " << p.init_log_std;
+      if (p.critic_warmup > 0) cmd << " --critic-warmup " << p.critic_warmup;
       return cmd.str();
     };
     nlohmann::json provenance = {
-        {"command", command(o.total_steps)},
-        {"seed", o.seed},
+        {"command", command(p.total_steps)},
+        {"seed", p.seed},
         {"algorithm", "PPO (clipped objective, GAE, Adam), Gaussian actor, state-independent log std; backbone = actor mean"},
-        {"profile", o.profile},
+        {"profile", p.profile},
         {"reward", "normalized_dense"},
-        {"num_envs", o.envs},
-        {"rollout_steps", o.rollout_steps},
-        {"minibatches", o.minibatches},
-        {"epochs", o.epochs},
-        {"learning_rate", o.learning_rate},
-        {"gamma", o.gamma},
-        {"gae_lambda", o.gae_lambda},
+        {"num_envs", p.num_envs},
+        {"rollout_steps", p.num_steps},
+        {"minibatches", p.num_minibatches},
+        {"epochs", p.update_epochs},
+        {"learning_rate", p.learning_rate},
+        {"gamma", p.gamma},
+        {"gae_lambda", p.gae_lambda},
         {"clip_coef", p.clip_coef},
         {"vf_coef", p.vf_coef},
         {"ent_coef", p.ent_coef},
         {"max_grad_norm", p.max_grad_norm},
-        {"target_kl", o.target_kl},
+        {"target_kl", p.target_kl},
         {"init_log_std", p.init_log_std}};
-    if (o.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", policy::kTrainingLags}};
-    if (o.anneal_lr) provenance["anneal_lr"] = true;
+    if (p.delay_aware) provenance["delay_aware"] = {{"history", policy::kHistoryLength}, {"training_lags", policy::kTrainingLags}};
+    if (p.anneal_lr) provenance["anneal_lr"] = true;
     if (!o.init_from.empty()) {
       provenance["init_from"] = {{"path", o.init_from}, {"sha256", init_sha}};
       if (p.init_actor->training.contains("env_steps")) provenance["init_from"]["env_steps"] = p.init_actor->training["env_steps"];
-      provenance["critic_warmup"] = o.critic_warmup;
+      provenance["critic_warmup"] = p.critic_warmup;
     }
     provenance["success"] = o.terminal_success ? "terminal" : "bootstrapped with the critic's value of the final observation";
-    const std::int64_t per_iter = static_cast<std::int64_t>(o.envs) * o.rollout_steps;
-    const std::int64_t iterations = std::max<std::int64_t>(1, o.total_steps / per_iter);
-    err << "train ppo: " << o.task << (o.delay_aware ? " (delay-aware)" : "") << ", layers "
-        << sim::observation_layout(p.task).size() + (o.delay_aware ? policy::kHistoryLength * kActionDim : 0) << "-" << o.hidden << "-7 (actor and critic), "
-        << iterations << " iterations x " << o.envs << " envs x " << o.rollout_steps << " steps = " << iterations * per_iter
-        << " env steps, seed " << o.seed << ", " << counted(static_cast<std::size_t>(policy::resolve_threads(o.threads)), "thread") << "\n";
+    const std::int64_t per_iter = static_cast<std::int64_t>(p.num_envs) * p.num_steps;
+    const std::int64_t iterations = std::max<std::int64_t>(1, p.total_steps / per_iter);
+    err << "train ppo: " << o.task << (p.delay_aware ? " (delay-aware)" : "") << ", layers "
+        << sim::observation_layout(p.task).size() + (p.delay_aware ? policy::kHistoryLength * kActionDim : 0) << "-" << o.hidden << "-7 (actor and critic), "
+        << iterations << " iterations x " << p.num_envs << " envs x " << p.num_steps << " steps = " << iterations * per_iter
+        << " env steps, seed " << p.seed << ", " << counted(static_cast<std::size_t>(policy::resolve_threads(p.threads)), "thread") << "\n";
     double last_eval = -1.0, last_eval_return = 0.0, best_eval = -1.0;
     std::int64_t best_steps = 0;
     const std::string best_path = stem + ".best.asmlp";
@@ -313,19 +272,13 @@ int run_train_ppo(const TrainPpoOptions& o, std::ostream& out, std::ostream& err
   }
 }
 
-int run_gate0(const Gate0Options& o, std::ostream& out, std::ostream& err) {
+int run_gate0(Gate0Options o, std::ostream& out, std::ostream& err) {
   std::unique_ptr<policy::Policy> pol;
-  policy::Gate0Run run;
+  policy::Gate0Run& run = o.run;  // --profile (checked while parsing), --episodes, --seed, --floor, --threads
   try {
     const sim::TaskId task = sim::parse_task(o.task);
-    if (o.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
-    run.episodes = o.episodes;
-    run.seed = o.seed;
-    (void)sim::profile_config(o.profile);  // validates the name
-    run.profile = o.profile;
-    run.floor = o.floor;
+    policy::check_gate0_run(run);
     run.rule = policy::parse_gate0_rule(o.rule);
-    run.threads = o.threads;
     if (!o.out.empty()) require_writable_output(o.out);  // before the episodes, not after them
     policy::RegistryOptions reg;
     reg.backbones_dir = o.backbones_dir;

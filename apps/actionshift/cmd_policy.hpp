@@ -1,8 +1,14 @@
 #pragma once
-// Policy subcommands of the actionshift CLI as plain functions (no CLI11 here): main.cpp maps parsed
-// options onto these structs. Each returns 0 ok, 1 check failed (Gate 0 "exclude"), 2 bad input.
+// Policy subcommands of the actionshift CLI as plain functions (no CLI11 here): cli_policy.cpp binds
+// the options straight into these structs, whose library settings (policy::TrainBcOptions,
+// policy::PpoOptions, policy::Gate0Run) are checked once, by the library's own check.
+// Each returns 0 ok, 1 check failed (Gate 0 "exclude"), 2 bad input.
 
 #include "commands.hpp"
+
+#include "actionshift/policy/gate0.hpp"
+#include "actionshift/policy/ppo.hpp"
+#include "actionshift/policy/train.hpp"
 
 #include <cstdint>
 #include <iostream>
@@ -13,63 +19,45 @@ namespace actionshift::cli {
 // `actionshift train bc --task T [--delay-aware] [--seed S] [--iterations N] [--episodes N]
 //  [--steps N] [--threads N] [--out FILE]`
 struct TrainBcOptions {
+  /// Bound directly: --profile, --delay-aware, --seed, --iterations, --episodes
+  /// (episodes_per_iteration), --steps (steps_per_iteration), --threads. `task` and `hidden` are
+  /// set from the text options below.
+  policy::TrainBcOptions train;
   std::string task;                 // --task
-  std::string profile{"maniskill"}; // --profile
-  bool delay_aware{false};          // --delay-aware: history of 4 actions, random lag {0,1,2,4}
-  std::uint64_t seed{20260718};     // --seed
-  int iterations{8};                // --iterations (DAgger iterations, the first is the expert's)
-  int episodes{64};                 // --episodes per iteration
-  int steps{1500};                  // --steps Adam steps per iteration
-  unsigned threads{0};              // --threads for data collection (0: all cores)
   std::string out;                  // --out FILE ("" → configs/backbones/<task>.mlp[-delay-aware].asmlp)
   std::string progress{"auto"};     // --progress auto|bar|lines|off: one line per iteration unless off
   std::string hidden{"256,256"};    // --hidden: tanh hidden layer widths, comma-separated
 };
-int run_train_bc(const TrainBcOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+int run_train_bc(TrainBcOptions options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
 // `actionshift train ppo --task T [--seed S] [--total-steps N] [--envs N] [--rollout-steps N] ...
 //  [--curve FILE] [--out FILE]`
 struct TrainPpoOptions {
-  std::string task;                 // --task
-  std::string profile{"maniskill"}; // --profile
-  std::uint64_t seed{20260718};     // --seed
-  std::int64_t total_steps{1'000'000};  // --total-steps (environment steps)
-  int envs{64};                     // --envs parallel environments
-  int rollout_steps{16};            // --rollout-steps per environment per iteration
-  int minibatches{2};               // --minibatches per epoch
-  int epochs{4};                    // --epochs per update
-  double learning_rate{3e-4};       // --lr
-  double gamma{0.8};                // --gamma
-  double gae_lambda{0.9};           // --gae-lambda
-  double target_kl{0.1};            // --target-kl (<= 0: off)
+  /// Bound directly: --profile, --seed, --total-steps, --envs (num_envs), --rollout-steps (num_steps),
+  /// --minibatches (num_minibatches), --epochs (update_epochs), --lr, --gamma, --gae-lambda,
+  /// --target-kl, --eval-every, --eval-episodes, --threads, --delay-aware, --anneal-lr, --stop-after
+  /// (stop_steps), --init-log-std, --critic-warmup. `task`, `hidden`, `bootstrap_success` and
+  /// `init_actor` are set from the options below.
+  policy::PpoOptions ppo;
+  std::string task;                   // --task
   std::string hidden{"256,256,256"};  // --hidden widths, comma separated
-  int eval_every{10};               // --eval-every iterations
-  int eval_episodes{32};            // --eval-episodes
-  unsigned threads{0};              // --threads (0: all cores)
-  std::string out;                  // --out FILE ("" → configs/backbones/<task>.ppo.asmlp)
-  std::string curve;                // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
-  std::string progress{"auto"};     // --progress auto|bar|lines|off
-  bool delay_aware{false};          // --delay-aware (observation ++ last 4 actions, lags {0,1,2,4})
-  bool anneal_lr{false};             // --anneal-lr (linear to 0, ManiSkill ppo.py's anneal_lr)
-  bool terminal_success{false};      // --terminal-success (value 0 after a success; earlier releases)
-  std::int64_t stop_after{0};        // --stop-after STEPS (0: none)
-  std::string init_from;             // --init-from FILE: warm-start the actor from a backbone file
-  double init_log_std{-0.5};         // --init-log-std
-  int critic_warmup{0};              // --critic-warmup ITERATIONS (actor frozen)
+  std::string out;                    // --out FILE ("" → configs/backbones/<task>.ppo.asmlp)
+  std::string curve;                  // --curve FILE ("" → <out without .asmlp>.curve.jsonl)
+  std::string progress{"auto"};       // --progress auto|bar|lines|off
+  bool terminal_success{false};       // --terminal-success (value 0 after a success; earlier releases)
+  std::string init_from;              // --init-from FILE: warm-start the actor from a backbone file
 };
-int run_train_ppo(const TrainPpoOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+int run_train_ppo(TrainPpoOptions options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
 // `actionshift gate0 --backbone B --task T --episodes N [--seed S] [--floor F] [--rule R]
 //  [--threads N] [--json] [--out FILE] [--backbones-dir DIR] [--step-timeout S]`
 struct Gate0Options {
+  /// Bound directly: --profile, --episodes, --seed, --floor (< 0: the task's reference floor),
+  /// --threads. `rule`, `robot` and `progress` are set from the options below.
+  policy::Gate0Run run;
   std::string backbone{"expert"};   // --backbone
   std::string task;                 // --task
-  std::string profile{"maniskill"}; // --profile
-  std::int64_t episodes{300};       // --episodes
-  std::uint64_t seed{20260718};     // --seed
-  double floor{-1.0};               // --floor (< 0: the task's reference floor)
   std::string rule{"wilson_lower"}; // --rule wilson_lower|point_estimate
-  unsigned threads{0};              // --threads (0: all cores)
   bool json{false};                 // --json: print the verdict file instead of text
   std::string out;                  // --out FILE: write the verdict file
   std::string backbones_dir;        // --backbones-dir ("" → default)
@@ -77,6 +65,6 @@ struct Gate0Options {
   std::string progress{"auto"};     // --progress auto|bar|lines|off (as `run`; --quiet = off)
   RobotOptions robot;               // --robot/--package
 };
-int run_gate0(const Gate0Options& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
+int run_gate0(Gate0Options options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 
 }  // namespace actionshift::cli

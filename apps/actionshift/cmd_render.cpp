@@ -3,7 +3,6 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/eval/job.hpp"
-#include "actionshift/eval/experiment.hpp"
 #include "actionshift/render/episode.hpp"
 #include "actionshift/render/image.hpp"
 #include "actionshift/render/leaderboard.hpp"

@@ -2,7 +2,6 @@
 // `actionshift render` (an episode as GIF or PNG), `actionshift montage` (renders side by side) and
 // `actionshift report` (HTML + Markdown page with figures): plain functions, no CLI11 here.
 
-#include "actionshift/eval/plan.hpp"
 #include "cmd_run.hpp"
 
 #include <cstdint>

@@ -5,10 +5,12 @@
 #include "actionshift/eval/external_method.hpp"
 
 #include "actionshift/core/error.hpp"
-#include "actionshift/core/json_input.hpp"
 #include "actionshift/core/input_file.hpp"
+#include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/calibrate.hpp"
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/resolve.hpp"
 #include "actionshift/sim/task.hpp"
 #include "commands.hpp"
 

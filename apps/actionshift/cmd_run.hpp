@@ -1,11 +1,12 @@
 #pragma once
 // `actionshift run` (single job or plan) and `actionshift calibrate`: plain functions binding the
-// eval layer's runner to the real episode function (eval/experiment.hpp). No CLI11 here.
+// eval layer's runner to the real episode function (eval/episode_fn.hpp). No CLI11 here.
 
 #include "cmd_eval.hpp"
 #include "commands.hpp"
 
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
+#include "actionshift/eval/plan_expand.hpp"
 #include "actionshift/sim/robot_source.hpp"
 
 #include <cstdint>

@@ -1,6 +1,7 @@
 #pragma once
-// Option structs and entry points of the CLI's subcommands. main.cpp (the only CLI11 translation
-// unit) fills the structs and calls these. Every entry point returns an ExitStatus.
+// Option structs and entry points of the CLI's subcommands. The cli_*.cpp files (with main.cpp the only
+// CLI11 translation units) bind the options into the structs and call these. Every entry point returns
+// an ExitStatus.
 
 #include <cstdint>
 #include <optional>

@@ -2,8 +2,8 @@
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/workers.hpp"
-#include "actionshift/eval/experiment.hpp"
 #include "actionshift/eval/provenance.hpp"
+#include "actionshift/eval/resolve.hpp"
 #include "actionshift/eval/store.hpp"
 #include "io.hpp"
 

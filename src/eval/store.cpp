@@ -1,6 +1,6 @@
 #include "actionshift/eval/store.hpp"
 
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/resolve.hpp"
 
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"

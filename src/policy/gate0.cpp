@@ -100,8 +100,12 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
   return v;
 }
 
+void check_gate0_run(const Gate0Run& run) {
+  if (run.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
+}
+
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
-  if (run.episodes <= 0) throw std::invalid_argument("at least one episode is required");
+  check_gate0_run(run);
   if (run.robot && run.robot_sha256.empty())
     throw InputError("gate0", "robot_sha256", "a robot description needs its content hash (sim::load_robot_source), which the verdict records");
   auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile), run.robot);

@@ -1,4 +1,5 @@
 // PPO (clipped objective, GAE, Adam) of a Gaussian actor-critic on Eigen, vectorised rollouts
+#include "actionshift/core/error.hpp"
 #include "actionshift/policy/ppo.hpp"
 
 #include "actionshift/core/hash.hpp"
@@ -350,15 +351,30 @@ MlpWeights PpoLearner::actor_weights(sim::TaskId task, const nlohmann::json& tra
   return w;
 }
 
+void check_ppo_options(const PpoOptions& o) {
+  if (o.total_steps <= 0) throw InputError("", "total-steps", "must be positive");
+  if (o.num_envs <= 0 || o.num_envs > 4096) throw InputError("", "envs", "must be in [1, 4096]");
+  if (o.num_steps <= 0) throw InputError("", "rollout-steps", "must be positive");
+  if (o.num_minibatches <= 0 || static_cast<std::int64_t>(o.num_envs) * o.num_steps < o.num_minibatches)
+    throw InputError("", "minibatches", "must be positive and at most envs x rollout-steps");
+  if (o.update_epochs <= 0) throw InputError("", "epochs", "must be positive");
+  if (!(o.learning_rate > 0) || !std::isfinite(o.learning_rate)) throw InputError("", "lr", "must be positive");
+  if (!(o.gamma >= 0 && o.gamma <= 1)) throw InputError("", "gamma", "must be in [0, 1]");
+  if (!(o.gae_lambda >= 0 && o.gae_lambda <= 1)) throw InputError("", "gae-lambda", "must be in [0, 1]");
+  if (o.eval_every < 0 || o.eval_episodes < 0) throw InputError("", "eval-every", "--eval-every and --eval-episodes must be non-negative");
+  if (o.stop_steps < 0) throw InputError("", "stop-after", "must be non-negative");
+  if (!std::isfinite(o.init_log_std) || o.init_log_std < -5 || o.init_log_std > 1)
+    throw InputError("", "init-log-std", "must be in [-5, 1]");
+  if (o.critic_warmup < 0) throw InputError("", "critic-warmup", "must be non-negative");
+  if (o.hidden.empty()) throw InputError("", "hidden", "at least one hidden layer is required");
+  for (int h : o.hidden)
+    if (h <= 0 || h > 4096) throw InputError("", "hidden", "layer widths must be in [1, 4096]");
+}
+
 PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
                     const std::function<void(const PpoIteration&)>& progress,
                     const std::function<void(const MlpWeights&)>& checkpoint) {
-  if (o.num_envs <= 0 || o.num_steps <= 0 || o.total_steps <= 0 || o.num_minibatches <= 0 || o.update_epochs <= 0 ||
-      o.hidden.empty() || !(o.learning_rate > 0) || o.eval_episodes < 0 || o.eval_every < 0 ||
-      static_cast<std::int64_t>(o.num_envs) * o.num_steps < o.num_minibatches || o.critic_warmup < 0)
-    throw std::invalid_argument("train_ppo: envs, steps, minibatches, epochs, hidden layers and learning rate must be positive");
-  for (int h : o.hidden)
-    if (h <= 0 || h > 4096) throw std::invalid_argument("train_ppo: hidden layer widths must be in [1, 4096]");
+  check_ppo_options(o);
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(o.threads);

@@ -1,4 +1,5 @@
 // DAgger behaviour cloning of the MLP backbone from the scripted experts (Eigen, Adam)
+#include "actionshift/core/error.hpp"
 #include "actionshift/policy/train.hpp"
 
 #include "actionshift/core/workers.hpp"
@@ -119,10 +120,15 @@ float train_step(MlpWeights& m, Adam& adam, const Eigen::MatrixXf& x, const Eige
 
 }  // namespace
 
+void check_train_bc_options(const TrainBcOptions& o) {
+  if (o.iterations <= 0 || o.episodes_per_iteration <= 0 || o.steps_per_iteration < 0)
+    throw InputError("", "train bc", "--iterations and --episodes must be positive, --steps non-negative");
+  if (o.batch_size <= 0 || o.hidden.empty() || !(o.learning_rate > 0))
+    throw InputError("", "train bc", "batch size, hidden layers and learning rate must be positive");
+}
+
 TrainBcResult train_bc(const TrainBcOptions& o, const std::function<void(const TrainIteration&)>& progress) {
-  if (o.iterations <= 0 || o.episodes_per_iteration <= 0 || o.steps_per_iteration < 0 || o.batch_size <= 0 ||
-      o.hidden.empty() || !(o.learning_rate > 0))
-    throw std::invalid_argument("train_bc: iterations, episodes, batch size, hidden layers and learning rate must be positive");
+  check_train_bc_options(o);
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const int history = o.delay_aware ? kHistoryLength : 0;

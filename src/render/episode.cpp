@@ -2,7 +2,7 @@
 #include "actionshift/render/episode.hpp"
 
 #include "actionshift/core/error.hpp"
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/render/renderer.hpp"
 #include "actionshift/sim/env.hpp"

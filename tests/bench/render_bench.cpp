@@ -1,7 +1,8 @@
 // Google Benchmark for the render layer: one 320x240 frame of PickCube, and a whole 50-step episode
 // rendered at 320x240 (runner episode, 51 frames with overlay, GIF encoding). One llvmpipe thread
 // (LP_NUM_THREADS=0: llvmpipe rasterises in the calling thread) so CPU time is all the work, on one core.
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/resolve.hpp"
 #include "actionshift/render/episode.hpp"
 #include "actionshift/render/image.hpp"
 #include "actionshift/render/renderer.hpp"

@@ -1,4 +1,7 @@
-#include "actionshift/eval/plan.hpp"
+#include "actionshift/eval/experiment_yaml.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/plan_io.hpp"
+#include "actionshift/eval/slurm.hpp"
 
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"

@@ -3,10 +3,12 @@
 #include "actionshift/adapt/plugin.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/core/error.hpp"
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/job.hpp"
-#include "actionshift/eval/runner.hpp"
+#include "actionshift/eval/plan_expand.hpp"
 #include "actionshift/eval/record.hpp"
+#include "actionshift/eval/resolve.hpp"
+#include "actionshift/eval/runner.hpp"
 
 #include "separation_probes.hpp"  // docs/examples/method_plugin
 

@@ -13,7 +13,7 @@ def adapter_for(method, truth):
 
 
 def run_episode(env, adapter, seed, steps, intent):
-    """The runner's loop (src/eval/experiment.cpp) written in Python."""
+    """The runner's loop (src/eval/episode_fn.cpp) written in Python."""
     obs, _ = env.reset(seed=seed)
     adapter.begin_episode(seed)
     probes = 0

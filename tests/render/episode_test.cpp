@@ -1,6 +1,8 @@
 // an episode rendered through the runner's episode function has the runner's record
 #include "actionshift/core/error.hpp"
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
+#include "actionshift/eval/plan_expand.hpp"
+#include "actionshift/eval/resolve.hpp"
 #include "actionshift/eval/runner.hpp"
 #include "actionshift/eval/summary.hpp"
 #include "actionshift/render/episode.hpp"

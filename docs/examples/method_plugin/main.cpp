@@ -6,8 +6,9 @@
 #include "separation_probes.hpp"
 
 #include <actionshift/core/error.hpp>
-#include <actionshift/eval/experiment.hpp>
-#include <actionshift/eval/plan.hpp>
+#include <actionshift/eval/episode_fn.hpp>
+#include <actionshift/eval/plan_expand.hpp>
+#include <actionshift/eval/resolve.hpp>
 #include <actionshift/eval/runner.hpp>
 
 #include <iostream>

@@ -82,6 +82,10 @@ struct Gate0Run {
   std::string robot_sha256;
 };
 
+/// The checks run_gate0 makes before any episode (the CLI makes them before it builds the backbone):
+/// at least one episode. Throws actionshift::InputError.
+void check_gate0_run(const Gate0Run& run);
+
 /// A Gate 0 verdict for one backbone and task.
 struct Gate0Verdict {
   std::string backbone, backbone_sha256, task;

@@ -89,6 +89,13 @@ struct PpoOptions {
   int critic_warmup{0};
 };
 
+/// The checks train_ppo makes before it starts (the CLI makes them before it writes anything): each
+/// count positive (envs at most 4096, minibatches at most envs x steps), learning rate positive and
+/// finite, gamma and GAE lambda in [0, 1], evaluation counts and stop_steps non-negative, init_log_std
+/// in [-5, 1], critic_warmup non-negative, hidden widths in [1, 4096]. Messages name the fields as the
+/// `train ppo` options spell them ("envs: must be in [1, 4096]"). Throws actionshift::InputError.
+void check_ppo_options(const PpoOptions& options);
+
 /// One training iteration (rollout + update).
 struct PpoIteration {
   int iteration{0};

@@ -57,8 +57,13 @@ struct TrainBcResult {
   double wall_seconds{0.0};
 };
 
+/// The checks train_bc makes before it starts (the CLI makes them before it writes anything): positive
+/// iterations, episodes, batch size, hidden layers and learning rate, non-negative steps. Messages name
+/// the fields as the `train bc` options spell them. Throws actionshift::InputError.
+void check_train_bc_options(const TrainBcOptions& options);
+
 /// Train an MLP backbone. `progress` (optional) is called after every iteration.
-/// Throws std::invalid_argument for non-positive counts or sizes.
+/// Throws std::invalid_argument (check_train_bc_options) for non-positive counts or sizes.
 TrainBcResult train_bc(const TrainBcOptions& options,
                        const std::function<void(const TrainIteration&)>& progress = {});
 

@@ -4,7 +4,7 @@
 /// (eval::make_episode_fn, observed after the reset and after every step), the same episode task
 /// (eval::episode_task: contract slot and seed), and the same record stamping.
 
-#include "actionshift/eval/experiment.hpp"
+#include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/job.hpp"
 #include "actionshift/eval/record.hpp"
 #include "actionshift/render/camera.hpp"

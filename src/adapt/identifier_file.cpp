@@ -1,28 +1,18 @@
-// The unprivileged tier: learned contract identifiers (weights, inference, the acting adapter)
+// Identifier weights and their file format (.asid): kinds, initialisation, serialise and parse
 #include "actionshift/adapt/identifier.hpp"
 
-#include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
-#include "actionshift/core/grammar.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/rng.hpp"
-#include "actionshift/core/transforms.hpp"
 #include "actionshift/core/weight_file.hpp"
+#include "identifier_detail.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
-#include <map>
-#include <mutex>
-#include <sstream>
 #include <stdexcept>
 
 namespace actionshift::adapt {
@@ -32,7 +22,7 @@ constexpr char kMagic[8] = {'A', 'S', 'I', 'D', 'W', '\0', '\0', '\1'};
 constexpr std::uint32_t kFormatVersion = 1;
 constexpr int kMaxWidth = 4096;
 constexpr int kMaxWindow = 256;
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 28;
+constexpr std::uintmax_t kMaxFileBytes = detail::kMaxIdentifierFileBytes;
 
 static_assert(std::endian::native == std::endian::little, "the .asid reader assumes a little-endian host");
 
@@ -66,13 +56,6 @@ std::int64_t readout_count(const std::vector<int>& layers) {
 
 std::int64_t recurrent_count(int hr) { return static_cast<std::int64_t>(hr) * kStepFeatures + static_cast<std::int64_t>(hr) * hr + hr; }
 
-int argmax(const Eigen::Ref<const Eigen::VectorXf>& v, int start, int n) {
-  int best = 0;
-  for (int k = 1; k < n; ++k)
-    if (v[start + k] > v[start + best]) best = k;
-  return best;
-}
-
 }  // namespace
 
 const char* identifier_kind_name(IdentifierKind k) {
@@ -89,81 +72,6 @@ std::optional<IdentifierKind> parse_identifier_kind(std::string_view name) {
   if (name == "probe_osi") return IdentifierKind::kProbeOsi;
   if (name == "recurrent_osi") return IdentifierKind::kRecurrentOsi;
   return std::nullopt;
-}
-
-FieldLabels FieldLabels::of(const Contract& c) {
-  FieldLabels l;
-  for (int i = 0; i < kPoseDim; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    l.permutation[k] = c.permutation()[k];
-    l.sign[k] = c.sign()[k] > 0 ? 1 : 0;
-    int s = 0;
-    for (int g = 0; g < static_cast<int>(grammar::kScaleGrid.size()); ++g)
-      if (std::abs(c.scale()[k] - grammar::kScaleGrid[static_cast<std::size_t>(g)]) <
-          std::abs(c.scale()[k] - grammar::kScaleGrid[static_cast<std::size_t>(s)]))
-        s = g;
-    l.scale[k] = s;
-  }
-  l.target = c.target() == Target::kAbsolute ? 1 : 0;
-  l.frame = c.frame() == Frame::kTool ? 1 : 0;
-  int lag = 0;
-  for (int g = 0; g < static_cast<int>(grammar::kLagGrid.size()); ++g)
-    if (std::abs(c.lag() - grammar::kLagGrid[static_cast<std::size_t>(g)]) < std::abs(c.lag() - grammar::kLagGrid[static_cast<std::size_t>(lag)]))
-      lag = g;
-  l.lag = lag;
-  l.gripper = c.gripper_inverted() ? 1 : 0;
-  return l;
-}
-
-std::array<double, 7> field_agreement(const Contract& p, const Contract& t) {
-  std::array<double, 7> a{};
-  for (int i = 0; i < kPoseDim; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    a[0] += p.permutation()[k] == t.permutation()[k] ? 1.0 / kPoseDim : 0.0;
-    a[1] += p.sign()[k] == t.sign()[k] ? 1.0 / kPoseDim : 0.0;
-    a[2] += p.scale()[k] == t.scale()[k] ? 1.0 / kPoseDim : 0.0;
-  }
-  a[3] = p.target() == t.target() ? 1.0 : 0.0;
-  a[4] = p.frame() == t.frame() ? 1.0 : 0.0;
-  a[5] = p.lag() == t.lag() ? 1.0 : 0.0;
-  a[6] = p.gripper_inverted() == t.gripper_inverted() ? 1.0 : 0.0;
-  return a;
-}
-
-Contract decode_logits(const Eigen::Ref<const Eigen::VectorXf>& z) {
-  if (z.size() != heads::kOutputs) throw std::invalid_argument("decode_logits: expected 100 logits");
-  ContractFields f;
-  // permutation: per-row softmax, then greedy conflict-free assignment
-  std::array<std::array<double, kPoseDim>, kPoseDim> prob{};
-  for (int i = 0; i < kPoseDim; ++i) {
-    const int o = heads::kPermutation + kPoseDim * i;
-    const float m = z.segment(o, kPoseDim).maxCoeff();
-    double sum = 0.0;
-    for (int j = 0; j < kPoseDim; ++j) sum += prob[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = std::exp(static_cast<double>(z[o + j] - m));
-    for (auto& p : prob[static_cast<std::size_t>(i)]) p /= sum;
-  }
-  std::array<int, kPoseDim> order{0, 1, 2, 3, 4, 5};
-  auto row_max = [&](int i) { return *std::max_element(prob[static_cast<std::size_t>(i)].begin(), prob[static_cast<std::size_t>(i)].end()); };
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return row_max(a) > row_max(b); });
-  std::array<bool, kPoseDim> used{};
-  for (int i : order) {
-    int best = -1;
-    for (int j = 0; j < kPoseDim; ++j)
-      if (!used[static_cast<std::size_t>(j)] && (best < 0 || prob[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] > prob[static_cast<std::size_t>(i)][static_cast<std::size_t>(best)]))
-        best = j;
-    used[static_cast<std::size_t>(best)] = true;
-    f.permutation[static_cast<std::size_t>(i)] = best;
-  }
-  for (int i = 0; i < kPoseDim; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    f.sign[k] = argmax(z, heads::kSign + 2 * i, 2) == 1 ? 1 : -1;
-    f.scale[k] = grammar::kScaleGrid[static_cast<std::size_t>(argmax(z, heads::kScale + 7 * i, 7))];
-  }
-  f.target = argmax(z, heads::kTarget, 2) == 1 ? "absolute" : "delta";
-  f.frame = argmax(z, heads::kFrame, 2) == 1 ? "tool" : "base";
-  f.lag = grammar::kLagGrid[static_cast<std::size_t>(argmax(z, heads::kLag, 4))];
-  f.gripper_inverted = argmax(z, heads::kGripper, 2) == 1;
-  return Contract::make(f);
 }
 
 std::int64_t IdentifierWeights::parameter_count() const { return readout_count(layers) + (recurrent > 0 ? recurrent_count(recurrent) : 0); }
@@ -298,136 +206,6 @@ void save_identifier(const IdentifierWeights& w, const std::string& path) { weig
 
 IdentifierWeights load_identifier(const std::string& path) {
   return parse_identifier(weight_file::read(path, kMaxFileBytes, "identifier weight file"), path);
-}
-
-std::string default_identifiers_dir() {
-  if (const char* env = std::getenv("ACTIONSHIFT_IDENTIFIERS_DIR"); env != nullptr && *env != '\0') return env;
-  std::error_code ec;
-  if (std::filesystem::is_directory(ACTIONSHIFT_DEFAULT_IDENTIFIERS_DIR, ec)) return ACTIONSHIFT_DEFAULT_IDENTIFIERS_DIR;
-  return ACTIONSHIFT_INSTALLED_IDENTIFIERS_DIR;
-}
-
-std::string identifier_weights_path(const std::string& weights, IdentifierKind kind, const std::string& dir) {
-  if (weights.find('/') != std::string::npos || weights.ends_with(".asid")) return weights;
-  return (dir.empty() ? default_identifiers_dir() : dir) + "/" + weights + "." + identifier_kind_name(kind) + ".asid";
-}
-
-std::shared_ptr<const IdentifierWeights> load_identifier_cached(const std::string& path, IdentifierKind kind) {
-  static std::mutex mu;
-  static std::map<std::string, std::shared_ptr<const IdentifierWeights>> cache;
-  std::lock_guard<std::mutex> lock(mu);
-  auto check_kind = [&](const std::shared_ptr<const IdentifierWeights>& w) {
-    if (w->kind != kind)
-      throw InputError(path, "header.kind", std::string("holds a ") + identifier_kind_name(w->kind) + " network, not " + identifier_kind_name(kind));
-    return w;
-  };
-  if (auto it = cache.find(path); it != cache.end()) return check_kind(it->second);
-  const std::string bytes = weight_file::read(path, kMaxFileBytes, "identifier weight file");
-  // a committed file is pinned by its directory's SHA256SUMS
-  const std::filesystem::path p(path);
-  const std::filesystem::path sums = p.parent_path() / "SHA256SUMS";
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(sums, ec)) {
-    std::istringstream in(read_input_file(sums.string(), "a SHA256SUMS file", kMaxSmallFileBytes));
-    std::string line;
-    while (std::getline(in, line)) {
-      std::istringstream ls(line);
-      std::string hash, name;
-      ls >> hash >> name;
-      if (!name.empty() && name[0] == '*') name.erase(0, 1);
-      if (name == p.filename().string() && hash != sha256_hex(bytes))
-        throw InputError(path, "sha256", "is " + sha256_hex(bytes) + " but " + sums.string() + " lists " + hash);
-    }
-  }
-  auto w = std::make_shared<const IdentifierWeights>(parse_identifier(bytes, path));
-  cache.emplace(path, w);
-  return check_kind(w);
-}
-
-Eigen::VectorXf identifier_features(const IdentifierWeights& w, const Pose6& raw, const Pose6& response) {
-  Eigen::VectorXf x(kStepFeatures);
-  x.head<6>() = raw.cast<float>();
-  x.tail<6>() = response.cast<float>();
-  return (x - w.feature_mean).cwiseQuotient(w.feature_std);
-}
-
-IdentifierState::IdentifierState(std::shared_ptr<const IdentifierWeights> w) : w_(std::move(w)) {
-  if (!w_) throw std::invalid_argument("IdentifierState: no weights");
-  reset();
-}
-
-void IdentifierState::reset() {
-  steps_ = 0;
-  window_ = Eigen::VectorXf::Zero(std::max(w_->window, 0) * kStepFeatures);
-  h_ = Eigen::VectorXf::Zero(std::max(w_->recurrent, 0));
-}
-
-void IdentifierState::feed(const Pose6& raw, const Pose6& response) { feed_normalised(identifier_features(*w_, raw, response)); }
-
-void IdentifierState::feed_normalised(const Eigen::Ref<const Eigen::VectorXf>& x) {
-  ++steps_;
-  if (w_->recurrent > 0) {
-    h_ = (w_->wx * x + w_->wh * h_ + w_->bh).array().tanh().matrix();
-  } else {
-    const Eigen::Index n = window_.size();
-    if (n > kStepFeatures) window_.head(n - kStepFeatures) = window_.tail(n - kStepFeatures).eval();
-    window_.tail(kStepFeatures) = x;
-  }
-}
-
-Eigen::VectorXf IdentifierState::logits() const {
-  Eigen::VectorXf h = w_->recurrent > 0 ? h_ : window_;
-  for (std::size_t i = 0; i < w_->w.size(); ++i) {
-    Eigen::VectorXf z = w_->w[i] * h + w_->b[i];
-    h = i + 1 < w_->w.size() ? Eigen::VectorXf(z.array().tanh()) : z;
-  }
-  return h;
-}
-
-IdentifierAdapter::IdentifierAdapter(std::shared_ptr<const IdentifierWeights> weights, IdentifierOptions options)
-    : state_(std::move(weights)), options_(options) {
-  sent_.reserve(64);
-}
-
-void IdentifierAdapter::begin_episode(std::uint64_t) {
-  state_.reset();
-  step_ = 0;
-  estimate_.reset();
-  sent_.clear();
-  replica_.reset();
-  last_ = {};
-}
-
-Action IdentifierAdapter::encode(const Action& canonical, const Mat3& R) {
-  last_ = {};
-  if (step_ < options_.probe_budget) {  // the fixed pulses of the belief methods: +a on channel k, gripper never actuated
-    Action a = Action::Zero();
-    a[step_ % kPoseDim] = (step_ / kPoseDim) % 2 == 0 ? options_.probe_amplitude : -options_.probe_amplitude;
-    last_.probe = true;
-    return a;
-  }
-  if (!estimate_) return canonical;  // pass-through evidence before the first estimate
-  return actionshift::encode(*estimate_, canonical, R, replica_->tracked_target());
-}
-
-void IdentifierAdapter::re_estimate() {
-  const Contract c = decode_logits(state_.logits());
-  if (!estimate_ || !(c == *estimate_)) {
-    estimate_ = c;
-    replica_.emplace(c);  // the tracked target the wrapper holds if the estimate is the truth
-    for (const auto& [raw, R] : sent_) replica_->step(raw, R);
-  }
-}
-
-void IdentifierAdapter::observe(const Action& raw, const Pose6& response, const Mat3& R) {
-  state_.feed(raw.head<6>(), response);
-  sent_.emplace_back(raw, R);
-  ++step_;
-  if (replica_) replica_->step(raw, R);
-  const int first = options_.probe_budget + options_.warmup;
-  if (step_ < first) return;
-  if (options_.freeze && estimate_) return;
-  re_estimate();
 }
 
 }  // namespace actionshift::adapt
