@@ -13,6 +13,11 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import table  # noqa: E402
 
+try:  # the statistics engine's Wilson interval (the Python module of a build: PYTHONPATH=<build>/python)
+    from actionshift import wilson_interval  # noqa: E402
+except ImportError:  # --choose needs no interval
+    wilson_interval = None
+
 GRAMMAR_PER_CHANNEL = ("permutation", "sign", "scale")
 FIELDS = ("permutation", "sign", "scale", "target", "frame", "lag", "gripper_inverted", "gripper_range", "rotation", "action")
 
@@ -116,6 +121,14 @@ def fmt_floor(x):
     return repr(float(x)).rstrip("0").rstrip(".") if "e" not in repr(float(x)) else repr(float(x))
 
 
+def interval(k, n):
+    """k/n with its Wilson 95 % interval (the statistics engine's), or a dash for n = 0."""
+    if n == 0:
+        return "—"
+    w = wilson_interval(k, n)
+    return f"{w['rate']:.3f} [{max(w['lower'], 0.0):.3f}, {min(w['upper'], 1.0):.3f}]"
+
+
 def summary_rows(audits, lengths):
     rows = []
     stats = {}
@@ -127,11 +140,63 @@ def summary_rows(audits, lengths):
         passes = sum(1 for a in sel if a["status"] == "PASS")
         mism = sum(1 for a in sel if a["status"] == "MISMATCH")
         cov = len(committed) / n if n else 0.0
-        err = wrong / len(committed) if committed else 0.0
         stats[L] = (n, len(committed), wrong, cov)
-        rows.append([str(L), str(n), str(passes), str(mism), str(n - len(committed)), f"{cov:.3f}", f"{wrong} / {len(committed)}",
-                     f"{err:.3f}"])
+        rows.append([str(L), str(n), str(passes), str(mism), str(n - len(committed)), interval(len(committed), n),
+                     f"{wrong} / {len(committed)}", interval(wrong, len(committed))])
     return rows, stats
+
+
+GROUPS = (("reference/expert", "reference splits, scripted expert"), ("reference/ppo", "reference splits, learned PPO"),
+          ("generated/expert", "generated splits (the full pool's test contracts), scripted expert"))
+
+
+def group_rows(audits, lengths):
+    """Per group of logs and length: audits, coverage and wrong / committed with their intervals."""
+    rows = []
+    for g, text in GROUPS:
+        for L in lengths:
+            sel = [a for a in audits if a["bench"].get("group", "reference/expert") == g and a["bench"]["length"] == L]
+            if not sel:
+                continue
+            committed = [a for a in sel if a["status"] != "INCONCLUSIVE"]
+            wrong = sum(1 for a in committed if verdict_wrong(a))
+            rows.append([text, str(L), str(len(sel)), interval(len(committed), len(sel)), f"{wrong} / {len(committed)}",
+                         interval(wrong, len(committed))])
+    return rows
+
+
+def wrong_rows(audits):
+    """Every wrong committed verdict: the log, the declaration, the verdict and each field it got wrong (identified
+    against recorded)."""
+    rows = []
+    for a in audits:
+        if not verdict_wrong(a):
+            continue
+        b = a["bench"]
+        bad = []
+        for f in FIELDS:
+            o = field_outcome(a, f)
+            if o is not None and o[2] != o[3]:
+                t = truth_value(b["truth"], f)
+                bad.append(f"`{f}` {a['fields'][f]['identified']} (recorded {'(' + ', '.join(t) + ')' if isinstance(t, list) else t})")
+        if a["status"] == "MISMATCH" and b["declared_as"] == "truth" and not bad:
+            bad.append("MISMATCH although the declaration is the recorded contract")
+        rows.append([b.get("group", "reference/expert"), f"`{b['split']}` c{b['contract']}", str(b["noise"]), str(b["seed"]),
+                     str(b["length"]), b["declared_as"], a["status"], "; ".join(bad) or "PASS against a different recording"])
+    return rows
+
+
+def split_rows(audits, length):
+    """The generated group per split at one length: which kinds of contract the audit commits on."""
+    rows = []
+    for split in sorted({a["bench"]["split"] for a in audits if a["bench"].get("group") == "generated/expert"}):
+        sel = [a for a in audits if a["bench"].get("group") == "generated/expert" and a["bench"]["split"] == split
+               and a["bench"]["length"] == length]
+        committed = [a for a in sel if a["status"] != "INCONCLUSIVE"]
+        wrong = sum(1 for a in committed if verdict_wrong(a))
+        contracts = len({a["bench"]["contract"] for a in sel})
+        rows.append([f"`{split}`", str(contracts), str(len(sel)), interval(len(committed), len(sel)), f"{wrong} / {len(committed)}"])
+    return rows
 
 
 def field_rows(audits, lengths):
@@ -166,7 +231,7 @@ def svg(stats_by_group, lengths, path):
     x0, x1 = min(xs), max(xs)
     px = lambda L: ml + (math.log10(L) - x0) / (x1 - x0 or 1) * (w - ml - mr)
     py = lambda c: mt + (1 - c) * (h - mt - mb)
-    colors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd"]
+    colors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"]
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
            f'<rect width="{w}" height="{h}" fill="white"/>']
     for c in (0, 0.25, 0.5, 0.75, 1.0):
@@ -217,7 +282,9 @@ def main():
     pilot = load(a.pilot)
     rows, stats = summary_rows(ev, lengths)
     groups = []
-    for name, pred in (("all", lambda x: True), ("clean", lambda x: x["bench"]["noise"] == 0),
+    for name, pred in (("all", lambda x: True), ("reference, expert", lambda x: x["bench"].get("group") == "reference/expert"),
+                       ("reference, PPO", lambda x: x["bench"].get("group") == "reference/ppo"),
+                       ("generated, expert", lambda x: x["bench"].get("group") == "generated/expert"),
                        ("sensor noise", lambda x: x["bench"]["noise"] > 0),
                        ("declared = truth", lambda x: x["bench"]["declared_as"] == "truth")):
         groups.append((name, summary_rows([x for x in ev if pred(x)], lengths)[1]))
@@ -227,6 +294,10 @@ def main():
     for (fl, tol), (n, com, wrong) in sorted(pilot_table(pilot).items()):
         pilot_rows.append([fmt_floor(fl), fmt_floor(tol), str(n), f"{com / n:.3f}", f"{wrong} / {com}"])
     worst = max((stats[L][2] / stats[L][1] if stats[L][1] else 0.0) for L in lengths)
+    worst_upper = max((min(wilson_interval(stats[L][2], stats[L][1])["upper"], 1.0) if stats[L][1] else 1.0) for L in lengths)
+    n_contracts = len({(a["bench"]["split"], a["bench"]["contract"]) for a in ev})
+    n_logs = len({(a["bench"].get("backbone", "expert"), a["bench"]["split"], a["bench"]["contract"], a["bench"]["noise"],
+                   a["bench"]["seed"]) for a in ev})
     lines = []
     lines.append("# Audit benchmark: identifying a log's action contract, with abstention\n")
     lines.append(f"Written by `scripts/audit_benchmark` → `scripts/audit_report.py`; command `{a.command}`, commit `{a.commit[:12]}`, "
@@ -234,13 +305,18 @@ def main():
     lines.append("**Question.** Given a log of commanded actions and measured TCP poses (no probing), does `actionshift audit` "
                  "name the contract the log was recorded under, or abstain, and how often is a committed verdict wrong? "
                  "Target: at most 1 % wrong among committed verdicts at every length.\n")
-    lines.append("**Logs.** `actionshift record --task pick_cube --method oracle --backbone expert` under each contract of "
-                 "`reference_seen` and `reference_unseen_composition` (2 + 2 contracts; the oracle makes the expert succeed "
-                 "while the log holds the raw numbers the hidden contract decodes), observation noise σ ∈ {"
-                 + ", ".join(a.noises.split()) + "} (m, rad), 5,000 transitions per (contract, noise, seed); shorter lengths are "
-                 "prefixes of the same log (`audit --max-steps`). Each log is audited twice: declared = the recorded contract "
-                 "(right answer PASS) and declared = identity (right answer MISMATCH naming the recorded contract). Response model: "
-                 "the task's built-in calibration (`--task pick_cube`).\n")
+    lines.append("**Logs.** `actionshift record --task pick_cube --method oracle` (the oracle makes the backbone succeed while "
+                 "the log holds the raw numbers the hidden contract decodes), observation noise σ ∈ {"
+                 + ", ".join(a.noises.split()) + "} (m, rad), 5,000 transitions per (contract, backbone, noise, seed); shorter "
+                 "lengths are prefixes of the same log (`audit --max-steps`). Three groups: every contract of `reference_seen` "
+                 "and `reference_unseen_composition` (2 + 2) with the scripted expert and with the committed learned backbone "
+                 "(`ppo`, configs/backbones/pick_cube.ppo.asmlp) under every seed; and every test contract of the five "
+                 "generated splits (`seen`, `unseen_composition`, `unseen_value`, `long_lag`, `task_transfer`: 160 of the "
+                 "`full` pool's 180 members, its other 20 being identity and distractors) with the expert, each contract under "
+                 "one evaluation seed (round robin) and every fourth under one pilot seed. Each log is audited twice: declared = "
+                 "the recorded contract (right answer PASS) and declared = identity (right answer MISMATCH naming the recorded "
+                 f"contract). Response model: the task's built-in calibration (`--task pick_cube`). Evaluation: {n_logs} logs of "
+                 f"{n_contracts} contracts.\n")
     lines.append(f"**Seeds.** Pilot (choose the confidence floor and the gain tolerance): {a.pilot_seeds}. Evaluation (this page): {a.eval_seeds}; "
                  "both registered in `configs/seeds.yaml` and checked disjoint (initial states included) by "
                  "`tests/eval/seed_registry_test.cpp`.\n")
@@ -252,10 +328,24 @@ def main():
                  "from the declaration, or MISMATCH while the declaration is the truth or any resolved field (per output "
                  "channel for permutation, sign and scale) is not the recorded value.\n")
     lines.append("## Coverage and error rate per log length (evaluation seeds)\n")
-    lines.append(table.markdown(["transitions", "audits", "PASS", "MISMATCH", "INCONCLUSIVE", "coverage", "wrong / committed", "error rate"], rows))
+    lines.append("Coverage and error rate with their Wilson 95 % intervals (the statistics engine's, `actionshift.wilson_interval`).\n")
+    lines.append(table.markdown(["transitions", "audits", "PASS", "MISMATCH", "INCONCLUSIVE", "coverage", "wrong / committed",
+                                 "error rate"], rows))
     lines.append("")
-    lines.append(f"Largest error rate among committed verdicts over the lengths: **{worst:.3f}** (target ≤ 0.010).\n")
+    lines.append(f"Largest error rate among committed verdicts over the lengths: **{worst:.3f}** (target ≤ 0.010); the largest "
+                 f"upper bound of its interval: {worst_upper:.3f}, what these counts can rule out.\n")
     lines.append("![coverage against log length](audit_coverage.svg)\n")
+    lines.append("## Per group of logs\n")
+    lines.append(table.markdown(["logs", "transitions", "audits", "coverage", "wrong / committed", "error rate"], group_rows(ev, lengths)))
+    lines.append("")
+    wr = wrong_rows(ev)
+    lines.append("### The wrong committed verdicts\n")
+    lines.append(table.markdown(["logs", "contract", "noise", "seed", "transitions", "declared", "verdict", "what it got wrong"], wr)
+                 if wr else "None.\n")
+    lines.append("")
+    lines.append(f"The generated splits per split at {lengths[-1]} transitions:\n")
+    lines.append(table.markdown(["split", "contracts", "audits", "coverage", "wrong / committed"], split_rows(ev, lengths[-1])))
+    lines.append("")
     lines.append("## Per field: how often resolved, and right when resolved\n")
     lines.append("Per-channel fields count output channels; `not checked` means the log cannot tell (e.g. the rotation "
                  "representation at these rotation sizes: the representations differ at second order only).\n")
