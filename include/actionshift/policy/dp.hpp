@@ -1,0 +1,119 @@
+#pragma once
+/// \file
+/// Diffusion Policy backbone (docs/backbones.md, "Diffusion Policy"): the state-based conditional
+/// 1-D convolutional U-Net of Chi et al. (ConditionalUnet1D) on Eigen with a hand-written backward
+/// pass, and the DDPM that trains and samples it.
+///
+/// Network (DpArch): the input is a noisy action chunk x (action_dim x horizon), the denoising step
+/// k and a global condition (the flattened stack of the last obs_horizon observations). The step is
+/// embedded (sinusoidal, step_embed_dim) and passed through Linear(d, 4d) - Mish - Linear(4d, d);
+/// cond = [step embedding, global condition]. Every conditional residual block is
+///   out = Conv1dBlock(x); [scale, bias] = Linear(Mish(cond)); out = scale * out + bias (FiLM);
+///   out = Conv1dBlock(out) + residual(x)   (residual: 1x1 Conv1d if the widths differ, else identity)
+/// with Conv1dBlock = Conv1d(kernel, padding kernel/2) - GroupNorm(groups) - Mish. Down path: per
+/// level two residual blocks, then (all but the last level) Conv1d(k=3, stride 2, padding 1); two
+/// middle blocks; up path: per level but the first (deepest first) concatenate the skip of that
+/// level, two residual blocks and ConvTranspose1d(k=4, stride 2, padding 1); final Conv1dBlock and
+/// 1x1 Conv1d to action_dim. The skip of the shallowest level is not used (as in the original).
+///
+/// Parameters live in one flat vector (DpUnet::parameter_count()); each tensor keeps PyTorch's
+/// layout: Linear (out, in), Conv1d (out, in, k), ConvTranspose1d (in, out, k), GroupNorm weight
+/// then bias, row-major. The order of tensors is that of DpUnet::tensors().
+///
+/// Gradients: DpUnet::backward accumulates d(loss)/d(parameters) given d(loss)/d(output) for one
+/// sample. The network is a class template so the gradient checks can run it in double; the
+/// policy and the trainer use float.
+
+#include "actionshift/policy/policy.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace actionshift::policy {
+
+/// Architecture and horizons of a Diffusion Policy network.
+struct DpArch {
+  int action_dim{7};
+  int obs_dim{42};
+  int obs_horizon{2};      ///< observations stacked into the condition
+  int pred_horizon{16};    ///< length of the predicted action chunk
+  int act_horizon{8};      ///< actions executed from a chunk before re-planning
+  int step_embed_dim{64};  ///< diffusion-step embedding width (even, >= 4)
+  std::vector<int> down_dims{64, 128, 256};
+  int kernel_size{5};      ///< odd
+  int groups{8};           ///< GroupNorm groups; divides every down dim
+  int diffusion_steps{100};
+
+  int cond_dim() const { return step_embed_dim + obs_horizon * obs_dim; }
+  /// Throws std::invalid_argument naming the first inconsistent field.
+  void validate() const;
+  nlohmann::json to_json() const;
+  bool operator==(const DpArch&) const = default;
+};
+
+/// One named tensor of the flat parameter vector.
+struct DpTensor {
+  std::string name;            ///< e.g. "down.0.0.block0.conv.weight"
+  std::int64_t offset{0};
+  std::vector<int> shape;      ///< PyTorch shape
+  std::int64_t size() const;
+};
+
+template <class S>
+using DpMat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+template <class S>
+using DpVec = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+
+/// The conditional U-Net. Stateless: parameters are passed to every call; per-call intermediate
+/// values live in a Workspace (one per thread).
+template <class S>
+class DpUnet {
+ public:
+  struct Workspace;
+  explicit DpUnet(const DpArch& arch);
+  ~DpUnet();
+  DpUnet(const DpUnet&);
+  DpUnet& operator=(const DpUnet&) = delete;
+
+  const DpArch& arch() const { return arch_; }
+  std::int64_t parameter_count() const { return count_; }
+  const std::vector<DpTensor>& tensors() const { return tensors_; }
+
+  /// PyTorch's default initialisation (weights and biases uniform in +-1/sqrt(fan_in); GroupNorm
+  /// weight 1, bias 0), seeded.
+  std::vector<S> init(std::uint64_t seed) const;
+  /// Scratch space of forward/backward (one per thread).
+  std::shared_ptr<Workspace> workspace() const;
+
+  /// Predicted noise (action_dim x pred_horizon) for the noisy chunk x (action_dim x pred_horizon),
+  /// denoising step `step` and global condition (obs_horizon * obs_dim). Keeps what backward needs
+  /// in `ws`.
+  DpMat<S> forward(const S* params, const DpMat<S>& x, double step, const DpVec<S>& global_cond, Workspace& ws) const;
+  /// Adds d(loss)/d(params) to `grad` (parameter_count() entries) for d(loss)/d(output) = dy of the
+  /// last forward on `ws`; if `dx` is given, sets it to d(loss)/d(x).
+  void backward(const S* params, const DpMat<S>& dy, Workspace& ws, S* grad, DpMat<S>* dx = nullptr) const;
+
+  struct Spec;  ///< layer offsets (defined in dp_net.cpp)
+
+ private:
+  DpArch arch_;
+  std::int64_t count_{0};
+  std::vector<DpTensor> tensors_;
+  std::unique_ptr<Spec> spec_;
+};
+
+extern template class DpUnet<float>;
+extern template class DpUnet<double>;
+
+/// Parameter count of the network of `arch` (without building it).
+std::int64_t dp_parameter_count(const DpArch& arch);
+
+}  // namespace actionshift::policy
