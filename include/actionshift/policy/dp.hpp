@@ -24,6 +24,7 @@
 /// sample. The network is a class template so the gradient checks can run it in double; the
 /// policy and the trainer use float.
 
+#include "actionshift/core/rng.hpp"
 #include "actionshift/policy/policy.hpp"
 
 #include <nlohmann/json.hpp>
@@ -113,7 +114,76 @@ class DpUnet {
 extern template class DpUnet<float>;
 extern template class DpUnet<double>;
 
-/// Parameter count of the network of `arch` (without building it).
+// ---- DDPM ----------------------------------------------------------------------------------------
+
+/// DDPM noise schedule as diffusers' DDPMScheduler with beta_schedule "squaredcos_cap_v2":
+/// alpha_bar(t) = cos((t + 0.008) / 1.008 * pi / 2)^2, beta_i = min(1 - alpha_bar((i+1)/T) /
+/// alpha_bar(i/T), 0.999), alphas_cumprod_i = prod_{j<=i} (1 - beta_j); i = 0..T-1 (double).
+struct DdpmSchedule {
+  std::vector<double> betas, alphas_cumprod;
+  int steps() const { return static_cast<int>(betas.size()); }
+  static DdpmSchedule squaredcos_cap_v2(int steps);
+};
+
+/// One reverse step of DDPM (diffusers' DDPMScheduler.step: epsilon prediction, "fixed_small"
+/// variance, clip_sample to [-1, 1] when `clip`): the sample at step t-1 from the sample x at step t
+/// and the predicted noise; `noise` (same shape, standard normal) is used for t > 0.
+DpMat<float> ddpm_step(const DdpmSchedule& s, int t, const DpMat<float>& x, const DpMat<float>& eps, const DpMat<float>& noise,
+                       bool clip = true);
+
+/// Samples an action chunk (action_dim x pred_horizon): DDPM over all the schedule's steps when
+/// `ddim_steps` = 0, else deterministic DDIM (eta 0, "leading" spacing, clip_sample, final alpha 1)
+/// over `ddim_steps` steps. Draws the initial noise (and DDPM's per-step noise) from `rng`.
+DpMat<float> dp_sample(const DpUnet<float>& net, const float* params, const DdpmSchedule& schedule, const DpVec<float>& cond,
+                       Rng& rng, DpUnet<float>::Workspace& ws, int ddim_steps = 0);
+
+/// Optimiser and EMA settings (defaults: ManiSkill's state Diffusion Policy).
+struct DpLearnOptions {
+  double learning_rate{1e-4};  ///< AdamW peak step size
+  double beta1{0.95}, beta2{0.999}, eps{1e-8};
+  double weight_decay{1e-6};   ///< decoupled (AdamW)
+  int warmup_steps{500};       ///< linear warm-up, then cosine decay to 0 at total_steps
+  int total_steps{0};          ///< 0 = constant step size after the warm-up
+  /// EMA as diffusers' EMAModel constructed from a parameter iterator with power=0.75 (use_ema_warmup
+  /// stays false, so the power has no effect): decay_n = min(ema_max_decay, (1 + s) / (10 + s)) with
+  /// s = n - 1 (decay 0 at the first update: the average starts at the weights).
+  double ema_max_decay{0.9999};
+  int shards{8};  ///< the batch is split into this many fixed shards whose gradients are summed in order
+};
+
+/// The DDPM trainer's state: weights, AdamW moments, EMA weights. step() is deterministic given the
+/// seed and the batch, whatever the thread count (the batch is split into fixed shards, each summed
+/// in sample order, the shards summed in shard order).
+class DpLearner {
+ public:
+  DpLearner(const DpArch& arch, const DpLearnOptions& options, std::uint64_t seed);
+  /// One AdamW step of the noise-prediction loss on a batch: actions[k] is a clean chunk
+  /// (action_dim x pred_horizon, in [-1, 1]), conds[k] its condition. For each sample a step
+  /// t ~ U{0..T-1} and noise ~ N(0, I) are drawn from a generator seeded by (seed, step number, k);
+  /// loss = mean over the batch and entries of (eps_theta(sqrt(abar_t) x0 + sqrt(1-abar_t) eps, t) - eps)^2.
+  /// Returns the loss (before the step). Throws std::invalid_argument on an empty batch or wrong shapes.
+  double step(const std::vector<DpMat<float>>& actions, const std::vector<DpVec<float>>& conds, unsigned threads);
+
+  const DpUnet<float>& net() const { return net_; }
+  const DdpmSchedule& schedule() const { return schedule_; }
+  const std::vector<float>& params() const { return params_; }
+  const std::vector<float>& ema() const { return ema_; }
+  int steps_done() const { return t_; }
+  /// Step size of the (1-based) optimiser step n.
+  double learning_rate(int n) const;
+  /// EMA decay of the (1-based) update n.
+  double ema_decay(int n) const;
+
+ private:
+  DpUnet<float> net_;
+  DpLearnOptions o_;
+  std::uint64_t seed_;
+  DdpmSchedule schedule_;
+  std::vector<float> params_, m_, v_, ema_;
+  int t_{0};
+};
+
+/// Parameter count of the network of `arch`.
 std::int64_t dp_parameter_count(const DpArch& arch);
 
 }  // namespace actionshift::policy
