@@ -183,6 +183,87 @@ class DpLearner {
   int t_{0};
 };
 
+// ---- weight file -------------------------------------------------------------------------------
+
+/// A trained Diffusion Policy: architecture, observation normalisation, (EMA) weights.
+///
+/// Weight file format (`.asdp`, little-endian; docs/backbones.md), the container of `.asmlp`:
+///   bytes 0-7   magic "ASDPW\0\0\1"
+///   bytes 8-11  uint32 format version (1)
+///   bytes 12-15 uint32 header length H
+///   H bytes     header, UTF-8 JSON: {"format":"actionshift-dp","version":1,"task":..,"obs_dim":..,
+///               "action_dim":7,"arch":{DpArch::to_json()},"scheduler":{"type":"ddpm",
+///               "beta_schedule":"squaredcos_cap_v2","train_steps":..,"prediction":"epsilon",
+///               "clip_sample":true},"sampler_ddim_steps":0|n,"normalization":{"obs":"mean_std",
+///               "action":"none"},"weights":"ema","parameters":P,"payload_floats":N,
+///               "payload_sha256":..,"training":{..}}
+///   payload     N float32: obs_mean[obs_dim], obs_std[obs_dim], then the P network parameters in the
+///               order of DpUnet::tensors()
+/// Loading checks every field, the payload length and its SHA-256, so a truncated, corrupt or
+/// wrong-shape file is a one-line actionshift::InputError naming the file and the field.
+struct DpWeights {
+  sim::TaskId task{sim::TaskId::kPickCube};
+  DpArch arch;
+  int ddim_steps{0};                    ///< sampler of the policy: 0 = DDPM over all steps, else DDIM
+  Eigen::VectorXf obs_mean, obs_std;    ///< obs_norm = (obs - mean) / std, per entry
+  std::vector<float> params;            ///< the (EMA) network weights
+  nlohmann::json training = nlohmann::json::object();  ///< provenance (command, seed, wall time, ...)
+};
+
+/// Serialise to the `.asdp` byte format.
+std::string serialize_dp(const DpWeights& w);
+/// Parse the `.asdp` byte format; `source` names the file in errors. Throws actionshift::InputError.
+DpWeights parse_dp(std::string_view bytes, const std::string& source);
+/// Write atomically (temporary file + rename). Throws std::runtime_error on I/O failure.
+void save_dp(const DpWeights& w, const std::string& path);
+/// Read and parse a weight file. Throws actionshift::InputError.
+DpWeights load_dp(const std::string& path);
+
+// ---- policy --------------------------------------------------------------------------------------
+
+/// The Diffusion Policy as a Policy: the last obs_horizon observations (at reset the stack is
+/// filled with the reset frame) condition a sampled chunk of pred_horizon actions, of which
+/// chunk[obs_horizon-1 .. obs_horizon-1+act_horizon) are executed one per step, then it re-plans
+/// (and on reset). Actions are clipped to [-1, 1]. Sampling noise is seeded by the episode's first
+/// observation and the chunk's index, so an episode's actions do not depend on which thread or
+/// after which other episodes it runs. Name "dp:<path>" as given to the registry.
+class DpPolicy final : public Policy {
+ public:
+  DpPolicy(std::shared_ptr<const DpWeights> weights, std::string sha256, std::string name);
+  /// Load from a file (hash = SHA-256 of its bytes); name "dp:<path>".
+  static std::unique_ptr<DpPolicy> from_file(const std::string& path);
+
+  void reset() override;
+  Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override;
+  std::string name() const override { return name_; }
+  std::string sha256() const override { return sha256_; }
+  sim::TaskId task() const override { return weights_->task; }
+  std::unique_ptr<Policy> clone() const override;
+  const DpWeights& weights() const { return *weights_; }
+  /// Chunks sampled since construction (re-plans), for tests and benchmarks.
+  std::int64_t chunks_sampled() const { return chunks_; }
+  /// Condition of the last re-plan: the normalised stacked observations, oldest first.
+  const DpVec<float>& last_condition() const { return cond_; }
+  /// The last sampled chunk (action_dim x pred_horizon), before clipping.
+  const DpMat<float>& last_chunk() const { return chunk_; }
+
+ private:
+  void plan();
+  std::shared_ptr<const DpWeights> weights_;
+  std::string sha256_, name_;
+  std::shared_ptr<const DpUnet<float>> net_;
+  std::shared_ptr<DpUnet<float>::Workspace> ws_;
+  DdpmSchedule schedule_;
+  std::vector<Eigen::VectorXf> frames_;  ///< normalised observations, oldest first
+  DpVec<float> cond_;
+  DpMat<float> chunk_;
+  int next_{0};                           ///< index into the executed part of the chunk
+  bool fresh_{true};                      ///< no observation seen since reset
+  std::uint64_t episode_seed_{0};
+  std::uint64_t chunk_index_{0};
+  std::int64_t chunks_{0};
+};
+
 /// Parameter count of the network of `arch`.
 std::int64_t dp_parameter_count(const DpArch& arch);
 
