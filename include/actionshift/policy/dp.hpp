@@ -264,6 +264,48 @@ class DpPolicy final : public Policy {
   std::int64_t chunks_{0};
 };
 
+// ---- training from the scripted expert -----------------------------------------------------------
+
+/// `train dp` settings. Demonstrations are episodes of the task's scripted expert (only successful
+/// ones are kept); training windows follow ManiSkill's state Diffusion Policy data set: for a demo of
+/// L steps, every start s in [-(obs_horizon-1), L - pred_horizon + act_horizon - 1) gives the
+/// observations s .. s+obs_horizon-1 (indices < 0 repeat the first frame) and the actions
+/// s .. s+pred_horizon-1 (before the start: the first action; past the end: zero motion with the last
+/// gripper command). Minibatches are drawn uniformly with replacement. Deterministic from the seed
+/// whatever the thread count.
+struct TrainDpOptions {
+  sim::TaskId task{sim::TaskId::kPickCube};
+  std::string profile{"maniskill"};        ///< simulator fidelity profile of the demonstrations
+  std::uint64_t seed{20260718};
+  std::vector<int> down_dims{32, 64, 128};  ///< the scaled network (1.26 M parameters); paper: 64/128/256
+  int demos{100};                          ///< expert episodes collected
+  int iterations{1000};                    ///< optimiser steps
+  int batch_size{64};
+  int ddim_steps{0};                       ///< sampler recorded in the file (0 = DDPM, all steps)
+  DpLearnOptions learn;                    ///< AdamW, warm-up + cosine (total = iterations), EMA
+  unsigned threads{0};                     ///< demonstration and gradient threads (0 = all cores)
+  int log_every{50};                       ///< progress callback period (iterations)
+};
+
+/// Progress of `train dp`.
+struct TrainDpProgress {
+  int iteration{0};       ///< optimiser steps done
+  double loss{0.0};       ///< mean noise-prediction loss since the last report
+  double seconds{0.0};    ///< wall time since the start
+};
+
+struct TrainDpResult {
+  DpWeights weights;                 ///< the EMA weights; `training` left for the caller
+  int demos{0}, demo_successes{0};   ///< collected, kept
+  std::int64_t windows{0};           ///< training windows in the data set
+  double collect_seconds{0.0}, train_seconds{0.0};
+  double final_loss{0.0};            ///< mean loss over the last log period
+};
+
+/// Collect expert demonstrations and train a Diffusion Policy. Throws std::invalid_argument for bad
+/// options, std::runtime_error if no demonstration succeeds.
+TrainDpResult train_dp(const TrainDpOptions& options, const std::function<void(const TrainDpProgress&)>& progress = {});
+
 /// Parameter count of the network of `arch`.
 std::int64_t dp_parameter_count(const DpArch& arch);
 
