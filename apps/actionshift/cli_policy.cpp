@@ -99,6 +99,23 @@ void register_policy_commands(CLI::App& app, CliContext& ctx) {
                   "Iterations at the start that train only the critic (actor frozen), for a warm start")->capture_default_str();
   ppo->add_option("--progress", ppo_o.progress, "auto, bar (one updating line), lines (one per iteration) or off")->capture_default_str();
   ppo->callback([&] { ctx.action = [&] { return cli::run_train_ppo(ppo_o); }; });
+  auto& dp_o = ctx.make<cli::TrainDpCliOptions>();
+  auto* dp = train->add_subcommand(
+      "dp", "Train a Diffusion Policy backbone (conditional 1-D U-Net, DDPM; docs/backbones.md) on the scripted expert's\n"
+            "demonstrations (Eigen, AdamW, EMA; seeded and deterministic). Writes FILE, used as --backbone dp:FILE.");
+  dp->add_option("--task", dp_o.task, "pick_cube, push_cube, pull_cube, stack_cube")->required();
+  dp->add_option("--out", dp_o.out, "Weight file (.asdp)")->required();
+  dp->add_option("--profile", dp_o.profile, "Simulator fidelity profile of the demonstrations")->check(kProfile)->capture_default_str();
+  dp->add_option("--seed", dp_o.seed, "Seed")->check(kSeed)->capture_default_str();
+  dp->add_option("--demos", dp_o.demos, "Expert episodes (only successful ones are kept)")->capture_default_str();
+  dp->add_option("--iterations", dp_o.iterations, "Optimiser steps")->capture_default_str();
+  dp->add_option("--batch", dp_o.batch, "Minibatch size")->capture_default_str();
+  dp->add_option("--down-dims", dp_o.down_dims, "U-Net widths per level, comma-separated (the paper: 64,128,256)")->capture_default_str();
+  dp->add_option("--ddim-steps", dp_o.ddim_steps, "Sampler of the policy: 0 = DDPM over all 100 steps, else DDIM steps")->capture_default_str();
+  dp->add_option("--lr", dp_o.learning_rate, "AdamW peak step size (500 warm-up steps, cosine decay)")->capture_default_str();
+  dp->add_option("--threads", dp_o.threads, "Threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
+  dp->add_option("--progress", dp_o.progress, "auto, bar or lines (one line per 50 iterations) or off")->capture_default_str();
+  dp->callback([&] { ctx.action = [&] { return cli::run_train_dp(dp_o); }; });
   auto& gate0_o = ctx.make<cli::Gate0Options>();
   auto* gate0 = app.add_subcommand(
       "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"

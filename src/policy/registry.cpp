@@ -4,6 +4,7 @@
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/policy/delay_aware.hpp"
+#include "actionshift/policy/dp.hpp"
 #include "actionshift/policy/expert.hpp"
 #include "actionshift/policy/mlp.hpp"
 
@@ -71,12 +72,21 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
                                                                       : "ppo needs a network without an action history");
     return p;
   }
+  if (backbone.starts_with("dp:")) {  // a Diffusion Policy weight file (dp.hpp), named by its path
+    const std::string path(backbone.substr(3));
+    if (path.empty()) throw InputError("", "backbone", "dp: needs a weight file, e.g. dp:pick_cube.asdp");
+    auto p = DpPolicy::from_file(path);
+    if (p->task() != task)
+      throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
+                                         std::string(sim::task_name(task)));
+    return p;
+  }
   if (backbone.starts_with("external:")) {
     return std::make_unique<ExternalPolicy>(external_command(backbone), task, options.external);
   }
   throw InputError("", "backbone",
                    "unknown backbone '" + std::string(backbone) +
-                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<path>, external:<command>)");
+                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<path>, dp:<path>, external:<command>)");
 }
 
 }  // namespace actionshift::policy

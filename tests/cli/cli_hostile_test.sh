@@ -279,6 +279,7 @@ expect_err "quat_wxyz" "zero quaternion"
 
 # ---- a long command checks its --out before the work, not after it (train bc wrote nowhere after its DAgger run)
 for args in "train bc --task pick_cube --iterations 1 --episodes 1" "train ppo --task pick_cube --total-steps 1024" \
+            "train dp --task pick_cube --demos 1 --iterations 1" \
             "gate0 --task pick_cube --episodes 2"; do
   start=$(date +%s)
   # shellcheck disable=SC2086  # the words are the arguments

@@ -18,6 +18,7 @@
 #include "actionshift/eval/statistics.hpp"
 #include "actionshift/policy/gate0.hpp"
 #include "actionshift/policy/ppo.hpp"
+#include "actionshift/policy/dp.hpp"
 #include "actionshift/policy/train.hpp"
 
 #include <gtest/gtest.h>
@@ -504,6 +505,7 @@ TEST(SeedRegistry, LibraryAndCliDefaultsAreRegisteredWithTheirRoles) {
       {policy::Gate0Run{}.seed, "evaluation", "policy::Gate0Run{}.seed (gate0)"},
       {policy::TrainBcOptions{}.seed, "training", "policy::TrainBcOptions{}.seed (train bc)"},
       {policy::PpoOptions{}.seed, "training", "policy::PpoOptions{}.seed (train ppo)"},
+      {policy::TrainDpOptions{}.seed, "training", "policy::TrainDpOptions{}.seed (train dp)"},
       {TrainIdentifierOptions{}.seed, "training", "TrainIdentifierOptions{}.seed (train identifier)"},
       {CalibrationOptions{}.seed, "calibration", "CalibrationOptions{}.seed (calibrate)"},
       {kBootstrapSeed, "bootstrap", "kBootstrapSeed (gate1, gate promote)"},

@@ -6,6 +6,7 @@
 ///   mlp                    <backbones_dir>/<task>.mlp.asmlp (mlp.hpp)
 ///   mlp-delay-aware        <backbones_dir>/<task>.mlp-delay-aware.asmlp
 ///   mlp:<path>             any weight file (its task must match)
+///   dp:<path>              a Diffusion Policy weight file, .asdp (dp.hpp; its task must match)
 ///   external:<command>     a process speaking JSON lines (external.hpp)
 
 #include "actionshift/policy/external.hpp"
@@ -47,7 +48,7 @@ struct BackboneIdentity {
 /// checks its weight file. Throws as make_policy does.
 BackboneIdentity backbone_identity(std::string_view backbone, sim::TaskId task, const RegistryOptions& options = {});
 
-/// The built-in backbone names (without the parameterised mlp:<path> and external:<command>).
+/// The built-in backbone names (without the parameterised mlp:<path>, dp:<path> and external:<command>).
 std::vector<std::string> builtin_backbones();
 
 }  // namespace actionshift::policy
