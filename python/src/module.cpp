@@ -6,7 +6,6 @@
 #include "actionshift/adapt/pool_belief.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/response.hpp"
-#include "actionshift/core/wilson.hpp"
 #include "actionshift/core/contract.hpp"
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
@@ -16,6 +15,7 @@
 #include "actionshift/core/transforms.hpp"
 #include "actionshift/core/validate.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
+#include "actionshift/eval/statistics.hpp"
 #include "actionshift/eval/calibrate.hpp"
 #include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/experiment_yaml.hpp"
@@ -1768,15 +1768,7 @@ PYBIND11_MODULE(_native, m) {
         if (total <= 0 || successes < 0 || successes > total)
           value_error("wilson_interval: need 0 <= successes <= total and total > 0 (got " + std::to_string(successes) + " of " +
                       std::to_string(total) + ")");
-        const WilsonInterval w = wilson_interval(successes, total);
-        py::dict d;
-        d["successes"] = w.successes;
-        d["total"] = w.total;
-        d["rate"] = w.rate;
-        d["lower"] = w.lower;
-        d["upper"] = w.upper;
-        d["confidence"] = w.confidence;
-        return d;
+        return json_to_py(eval::wilson_json(wilson_interval(successes, total)).dump());
       },
       py::arg("successes"), py::arg("total"),
       "Wilson score 95 % interval of successes/total, as Gate 0 and compare compute it (not clamped).");
