@@ -15,8 +15,9 @@ from pages import table  # noqa: E402
 
 try:  # the statistics engine's Wilson interval (the Python module of a build: PYTHONPATH=<build>/python)
     from actionshift import wilson_interval  # noqa: E402
-except ImportError:  # --choose needs no interval
-    wilson_interval = None
+except ImportError:  # --choose needs no interval; the page does
+    def wilson_interval(k, n):
+        sys.exit("audit_report.py: the page's intervals need the actionshift module (PYTHONPATH=<build>/python)")
 
 GRAMMAR_PER_CHANNEL = ("permutation", "sign", "scale")
 FIELDS = ("permutation", "sign", "scale", "target", "frame", "lag", "gripper_inverted", "gripper_range", "rotation", "action")
@@ -267,6 +268,7 @@ def main():
     ap.add_argument("--command", default="")
     ap.add_argument("--commit", default="")
     ap.add_argument("--wall", default="")
+    ap.add_argument("--wall-note", default="", help="how the wall time was measured, when not by one uninterrupted run")
     ap.add_argument("--pilot-seeds", default="")
     ap.add_argument("--eval-seeds", default="")
     ap.add_argument("--lengths", default="")
@@ -293,6 +295,9 @@ def main():
     pilot_rows = []
     for (fl, tol), (n, com, wrong) in sorted(pilot_table(pilot).items()):
         pilot_rows.append([fmt_floor(fl), fmt_floor(tol), str(n), f"{com / n:.3f}", f"{wrong} / {com}"])
+    pt = pilot_table(pilot)
+    key = next((k for k in pt if fmt_floor(k[0]) == fmt_floor(float(a.floor)) and fmt_floor(k[1]) == fmt_floor(float(a.tolerance))), None)
+    chosen_committed, chosen_wrong = (pt[key][1], pt[key][2]) if key else (0, 0)
     worst = max((stats[L][2] / stats[L][1] if stats[L][1] else 0.0) for L in lengths)
     worst_upper = max((min(wilson_interval(stats[L][2], stats[L][1])["upper"], 1.0) if stats[L][1] else 1.0) for L in lengths)
     n_contracts = len({(a["bench"]["split"], a["bench"]["contract"]) for a in ev})
@@ -301,7 +306,7 @@ def main():
     lines = []
     lines.append("# Audit benchmark: identifying a log's action contract, with abstention\n")
     lines.append(f"Written by `scripts/audit_benchmark` → `scripts/audit_report.py`; command `{a.command}`, commit `{a.commit[:12]}`, "
-                 f"wall time {a.wall} s. Do not edit by hand.\n")
+                 f"wall time {a.wall} s{' (' + a.wall_note + ')' if a.wall_note else ''}. Do not edit by hand.\n")
     lines.append("**Question.** Given a log of commanded actions and measured TCP poses (no probing), does `actionshift audit` "
                  "name the contract the log was recorded under, or abstain, and how often is a committed verdict wrong? "
                  "Target: at most 1 % wrong among committed verdicts at every length.\n")
@@ -322,7 +327,9 @@ def main():
                  "`tests/eval/seed_registry_test.cpp`.\n")
     lines.append(f"**Thresholds.** The confidence floor (grid {{{', '.join(a.floors.split())}}}) and the gain tolerance (grid "
                  f"{{{', '.join(a.tolerances.split())}}}) are the pair with no wrong committed verdict among the pilot audits and the "
-                 f"highest pilot coverage: **floor {a.floor}, gain tolerance {a.tolerance}**. The misspecification ratio (25) and the "
+                 f"highest pilot coverage, or, when no pair is clean, the one with the fewest wrong: **floor {a.floor}, gain "
+                 f"tolerance {a.tolerance}**" + (f" ({chosen_wrong} of its {chosen_committed} committed pilot verdicts wrong: no pair "
+                 f"was clean)" if chosen_wrong else " (clean on the pilot)") + ". The misspecification ratio (25) and the "
                  "minimum excitation (0.1) are the defaults, fixed before the run (not tuned).\n")
     lines.append("**Wrong.** A committed verdict is wrong if it is PASS while a checked field of the recorded conventions differs "
                  "from the declaration, or MISMATCH while the declaration is the truth or any resolved field (per output "
