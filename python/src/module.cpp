@@ -462,6 +462,21 @@ std::uint64_t next_seed(std::optional<std::uint64_t>& last) {
 }
 
 // Closed environments: every later call raises this (close() itself may be called again).
+// A member guarded by an environment's mutex, read or written from Python: the GIL is released before
+// the mutex is taken (the lock order of PyEnv and PyVecEnv).
+template <class T>
+T read_guarded(std::mutex& m, const T& value) {
+  py::gil_scoped_release release;
+  std::lock_guard<std::mutex> lock(m);
+  return value;
+}
+template <class T>
+void write_guarded(std::mutex& m, T& value, T v) {
+  py::gil_scoped_release release;
+  std::lock_guard<std::mutex> lock(m);
+  value = std::move(v);
+}
+
 [[noreturn]] void closed_error() { throw std::runtime_error("environment is closed (close() released its simulation)"); }
 
 // One environment under a hidden contract (identity if none was given). Observations come back as
@@ -587,16 +602,8 @@ class PyEnv {
   const std::string& rotation() const { return options_.rotation; }
   const std::string& robot_sha256() const { return ref_.robot_sha256; }
   // the seed of the last reset (None before the first): what a pickled environment carries
-  std::optional<std::uint64_t> last_seed() {
-    py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(mutex_);
-    return last_seed_;
-  }
-  void set_last_seed(std::optional<std::uint64_t> s) {
-    py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(mutex_);
-    last_seed_ = s;
-  }
+  std::optional<std::uint64_t> last_seed() { return read_guarded(mutex_, last_seed_); }
+  void set_last_seed(std::optional<std::uint64_t> s) { write_guarded(mutex_, last_seed_, s); }
 
  private:
   EnvOptions options_;
@@ -814,16 +821,8 @@ class PyVecEnv {
   }
 
   // the base seed of the last reset (None before the first): what a pickled environment carries
-  std::optional<std::uint64_t> last_seed() {
-    py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(mutex_);
-    return last_seed_;
-  }
-  void set_last_seed(std::optional<std::uint64_t> s) {
-    py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(mutex_);
-    last_seed_ = s;
-  }
+  std::optional<std::uint64_t> last_seed() { return read_guarded(mutex_, last_seed_); }
+  void set_last_seed(std::optional<std::uint64_t> s) { write_guarded(mutex_, last_seed_, s); }
 
  private:
   // one environment's step, copied out on its worker thread
