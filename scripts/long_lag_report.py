@@ -203,40 +203,38 @@ def probing_section(C, w):
     w("Success with its Wilson 95 % interval pooled over the seeds, mean probe steps per episode, and compare's\n"
       "paired difference entropy − fixed on the same episodes (`(excludes 0)` where its interval does). The paper's\n"
       "columns hold its frozen-PPO Table 5 numbers beside our `ppo` rows on `reference_long_lag` only.\n")
-    for split in SPLITS:
-        rows = []
-        for task in C.values("task"):
-            for rb, db in PAIRS:
-                for b in (rb, db):
-                    f, e = C.cell(task, split, "fixed_probes", b), C.cell(task, split, "entropy_probes", b)
-                    if not f and not e:
-                        continue
-                    rows.append([task, f"`{b}`", fmt.cell_rate(f), fmt.probe_steps(f), fmt.cell_rate(e), fmt.probe_steps(e),
-                                 fmt.cmp_diff(within(C, task, split, "entropy_probes", b), mark=True),
-                                 paper_probe_cell(f, b, split), paper_probe_cell(e, b, split)])
-        if rows:
-            w(f"**{split}**\n")
-            w(table.markdown(["task", "backbone", "fixed probes (Wilson 95 %)", "probe steps", "entropy probes (Wilson 95 %)",
-                              "probe steps", "entropy − fixed [95 %]", "paper fixed (frozen PPO)",
-                              "paper entropy (frozen PPO)"], rows, ["l", "l", "l", "r", "l", "r", "l", "l", "l"]))
+    def per_backbone_tables(methods, row, header, align):
+        """One table per split: a row per task and backbone holding any of `methods`."""
+        for split in SPLITS:
+            rows = []
+            for task in C.values("task"):
+                for rb, db in PAIRS:
+                    for b in (rb, db):
+                        cells = [C.cell(task, split, m, b) for m in methods]
+                        if any(cells):
+                            rows.append([task, f"`{b}`"] + row(task, split, b, *cells))
+            if rows:
+                w(f"**{split}**\n")
+                w(table.markdown(header, rows, align))
+
+    per_backbone_tables(
+        ("fixed_probes", "entropy_probes"),
+        lambda task, split, b, f, e: [fmt.cell_rate(f), fmt.probe_steps(f), fmt.cell_rate(e), fmt.probe_steps(e),
+                                      fmt.cmp_diff(within(C, task, split, "entropy_probes", b), mark=True),
+                                      paper_probe_cell(f, b, split), paper_probe_cell(e, b, split)],
+        ["task", "backbone", "fixed probes (Wilson 95 %)", "probe steps", "entropy probes (Wilson 95 %)",
+         "probe steps", "entropy − fixed [95 %]", "paper fixed (frozen PPO)", "paper entropy (frozen PPO)"],
+        ["l", "l", "l", "r", "l", "r", "l", "l", "l"])
     w("The project's `{calibrated}` variant against fixed probing on the same episodes, and DualABI (the paper's\n"
       "rule; the paper's DualABI number is of one seed, a pruning signal).\n")
-    for split in SPLITS:
-        rows = []
-        for task in C.values("task"):
-            for rb, db in PAIRS:
-                for b in (rb, db):
-                    k, d = C.cell(task, split, "entropy_probes{calibrated}", b), C.cell(task, split, "dualabi", b)
-                    if not k and not d:
-                        continue
-                    rows.append([task, f"`{b}`", fmt.cell_rate(k), fmt.probe_steps(k),
-                                 fmt.cmp_diff(within(C, task, split, "entropy_probes{calibrated}", b), mark=True),
-                                 fmt.cell_rate(d), fmt.probe_steps(d), paper_probe_cell(d, b, split)])
-        if rows:
-            w(f"**{split}**\n")
-            w(table.markdown(["task", "backbone", "entropy probes `{calibrated}` (Wilson 95 %)", "probe steps",
-                              "`{calibrated}` − fixed [95 %]", "DualABI (Wilson 95 %)", "probe steps",
-                              "paper DualABI (frozen PPO)"], rows, ["l", "l", "l", "r", "l", "l", "r", "l"]))
+    per_backbone_tables(
+        ("entropy_probes{calibrated}", "dualabi"),
+        lambda task, split, b, k, d: [fmt.cell_rate(k), fmt.probe_steps(k),
+                                      fmt.cmp_diff(within(C, task, split, "entropy_probes{calibrated}", b), mark=True),
+                                      fmt.cell_rate(d), fmt.probe_steps(d), paper_probe_cell(d, b, split)],
+        ["task", "backbone", "entropy probes `{calibrated}` (Wilson 95 %)", "probe steps", "`{calibrated}` − fixed [95 %]",
+         "DualABI (Wilson 95 %)", "probe steps", "paper DualABI (frozen PPO)"],
+        ["l", "l", "l", "r", "l", "l", "r", "l"])
     w("### Verdict: the paper's claim (PPO, `reference_long_lag`)\n")
     claim_rows, rows = [], []
     for task in C.values("task"):
