@@ -94,27 +94,48 @@ double GrammarBelief::drive(int m, int j) const {
   return mode.target == Target::kDelta ? x : x - history_[lag + 1][j];
 }
 
-void GrammarBelief::add_cells(const Pose6& obs, const std::array<Pose6, kModes>& base,
-                              const std::array<double, kPoseDim>& sigma) {
-  for (int m = 0; m < kModes; ++m)
-    for (int i = 0; i < kPoseDim; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      const double a = model_.alpha[ii];
-      const double inv = 1.0 / sigma[ii];
-      double* cell = &S_[index(m, i, 0, 0, 0)];
-      for (int j = 0; j < kPoseDim; ++j) {
-        const double b = a * base[static_cast<std::size_t>(m)][j];
-        for (std::size_t sk = 0; sk < coef_.size(); ++sk) {
-          const double r = (obs[i] - b * coef_[sk]) * inv;
-          *cell++ -= 0.5 * r * r;
-        }
+void GrammarBelief::add_mode_cells(int m, const Pose6& obs, const Pose6& base, const std::array<double, kPoseDim>& sigma) {
+  for (int i = 0; i < kPoseDim; ++i) {
+    const auto ii = static_cast<std::size_t>(i);
+    const double a = model_.alpha[ii];
+    const double inv = 1.0 / sigma[ii];
+    double* cell = &S_[index(m, i, 0, 0, 0)];
+    for (int j = 0; j < kPoseDim; ++j) {
+      const double b = a * base[j];
+      for (std::size_t sk = 0; sk < coef_.size(); ++sk) {
+        const double r = (obs[i] - b * coef_[sk]) * inv;
+        *cell++ -= 0.5 * r * r;
       }
     }
+  }
+}
+
+void GrammarBelief::add_cells(const Pose6& obs, const std::array<Pose6, kModes>& base,
+                              const std::array<double, kPoseDim>& sigma) {
+  for (int m = 0; m < kModes; ++m) add_mode_cells(m, obs, base[static_cast<std::size_t>(m)], sigma);
+}
+
+void GrammarBelief::push_history(const Action& raw) {
+  for (int d = kHistory - 1; d > 0; --d) history_[static_cast<std::size_t>(d)] = history_[static_cast<std::size_t>(d - 1)];
+  history_[0] = raw.head<kPoseDim>();
+}
+
+void GrammarBelief::update_per_mode(const Action& raw, const std::array<Pose6, kModes>& observed) {
+  if (corrector_ || reanchor_period_ > 0)
+    throw std::logic_error("GrammarBelief::update_per_mode: a belief with a scale corrector or re-anchoring takes one observation per step");
+  push_history(raw);
+  have_command_ = false;
+  ++steps_since_reset_;
+  Pose6 base;
+  for (int m = 0; m < kModes; ++m) {
+    for (int j = 0; j < kPoseDim; ++j) base[j] = drive(m, j);
+    add_mode_cells(m, observed[static_cast<std::size_t>(m)], base, model_.sigma);
+  }
+  map_valid_ = false;
 }
 
 void GrammarBelief::update(const Action& raw, const Pose6& observed, bool hold, bool window_close, bool corrector_active) {
-  for (int d = kHistory - 1; d > 0; --d) history_[static_cast<std::size_t>(d)] = history_[static_cast<std::size_t>(d - 1)];
-  history_[0] = raw.head<kPoseDim>();
+  push_history(raw);
   // the scale corrector learns from the previous map_encode's command, before scoring (reference order)
   if (corrector_ && have_command_) corrector_->accumulate(last_command_, observed, last_eff_scale_, corrector_active);
   have_command_ = false;

@@ -252,6 +252,7 @@ inline std::size_t cidx(int f, int m, int i, int j, int sk) {
 struct Step {
   Action raw;
   Pose6 response;                      // measured, physical units
+  Pose6 cumulative;                    // Σ of the episode's responses through this step
   Mat3 R;                              // TCP orientation before the step
   Vec3 pos, next_pos;
   std::optional<double> finger_next;   // mean finger position after the step
@@ -278,6 +279,7 @@ std::vector<std::vector<Step>> transitions_of(const ActionLog& log) {
       s.next_pos = b.position;
       if (b.fingers) s.finger_next = 0.5 * ((*b.fingers)[0] + (*b.fingers)[1]);
       s.first = t == 0;
+      s.cumulative = (steps.empty() ? Pose6::Zero() : steps.back().cumulative) + s.response;
       steps.push_back(s);
     }
     if (!steps.empty()) out.push_back(std::move(steps));
@@ -292,15 +294,33 @@ double drive(const std::vector<Step>& ep, std::size_t t, Target target, int lag,
   return target == Target::kDelta ? x : x - at(static_cast<std::size_t>(lag) + 1);
 }
 
-// the working observation: normalised by α, rotated into the tool frame for f = 1
-Pose6 working(const Step& s, const std::array<double, kPoseDim>& alpha, int f) {
-  Pose6 y;
-  for (int c = 0; c < kPoseDim; ++c) y[c] = s.response[c] / alpha[static_cast<std::size_t>(c)];
-  if (f == 1) {
-    y.head<3>() = s.R.transpose() * Vec3(y.head<3>());
-    y.tail<3>() = s.R.transpose() * Vec3(y.tail<3>());
-  }
-  return y;
+// The response of step t in the coordinates a hypothesis (frame f, target, lag) decodes in, each
+// channel divided by `alpha` first. Base frame (f = 0): as measured. Tool frame (f = 1), exactly as
+// the controller decodes: the command that moved the robot at step t was decoded `lag` steps earlier,
+// under that step's rotation R_{t−L}, so a delta is R_{t−L}ᵀ·response_t; an absolute target is the
+// difference of two targets decoded under two rotations, and since the tracked target starts at zero
+// with the episode, the cumulative response s_t is the target: R_{t−L}ᵀ·s_t − R_{t−L−1}ᵀ·s_{t−1}.
+// (Reading both under the current rotation, as a first version did, is wrong by the turn between
+// the two steps times the whole target: at a 1.2 rad excursion it named a tool-frame absolute log
+// base frame with flipped signs.) Before the episode's start the rotation is the first step's.
+Pose6 working(const std::vector<Step>& ep, std::size_t t, const std::array<double, kPoseDim>& alpha, int f, Target target, int lag) {
+  const auto scaled = [&](const Pose6& v) {
+    Pose6 y;
+    for (int c = 0; c < kPoseDim; ++c) y[c] = v[c] / alpha[static_cast<std::size_t>(c)];
+    return y;
+  };
+  const auto into = [&](std::size_t back, const Pose6& v) {  // v in the tool frame of step t − back
+    const Mat3& Rt = ep[t >= back ? t - back : 0].R;
+    Pose6 y;
+    y.head<3>() = Rt.transpose() * Vec3(v.head<3>());
+    y.tail<3>() = Rt.transpose() * Vec3(v.tail<3>());
+    return y;
+  };
+  const auto L = static_cast<std::size_t>(lag);
+  if (f == 0) return scaled(ep[t].response);
+  if (target == Target::kDelta) return into(L, scaled(ep[t].response));
+  const Pose6 now = into(L, scaled(ep[t].cumulative));
+  return t == 0 ? now : Pose6(now - into(L + 1, scaled(ep[t - 1].cumulative)));
 }
 
 std::array<double, kPoseDim> isotropic(const std::array<double, kPoseDim>& s) {
@@ -321,7 +341,18 @@ Cells evidence(const std::vector<std::vector<Step>>& eps, const std::array<doubl
   for (int f = 0; f < kFrames; ++f)
     for (const auto& ep : eps) {
       adapt::GrammarBelief b(unit);
-      for (const auto& s : ep) b.update(s.raw, working(s, alpha, f));
+      std::array<Pose6, kModes> y;
+      for (std::size_t t = 0; t < ep.size(); ++t) {
+        if (f == 0) {
+          b.update(ep[t].raw, working(ep, t, alpha, 0, Target::kDelta, 0));
+          continue;
+        }
+        for (int m = 0; m < kModes; ++m) {
+          const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
+          y[static_cast<std::size_t>(m)] = working(ep, t, alpha, 1, mode.target, mode.lag);
+        }
+        b.update_per_mode(ep[t].raw, y);
+      }
       for (int m = 0; m < kModes; ++m)
         for (int i = 0; i < kPoseDim; ++i)
           for (int j = 0; j < kPoseDim; ++j)
@@ -472,7 +503,7 @@ Residuals residuals(const std::vector<std::vector<Step>>& eps, const std::array<
   for (const auto& ep : eps) {
     Pose6 prev = Pose6::Zero();
     for (std::size_t t = 0; t < ep.size(); ++t) {
-      const Pose6 y = working(ep[t], alpha, c.frame() == Frame::kTool ? 1 : 0);
+      const Pose6 y = working(ep, t, alpha, c.frame() == Frame::kTool ? 1 : 0, c.target(), c.lag());
       for (int i = 0; i < kPoseDim; ++i) {
         const auto ii = static_cast<std::size_t>(i);
         const double pred = c.sign()[ii] * c.scale()[ii] * drive(ep, t, c.target(), c.lag(), c.permutation()[ii]);
@@ -532,8 +563,8 @@ std::array<double, 3> rotation_rep_posterior(const std::vector<std::vector<Step>
         const auto ii = static_cast<std::size_t>(i);
         v[i - 3] = alpha[ii] * c.sign()[ii] * c.scale()[ii] * drive(ep, t, c.target(), c.lag(), c.permutation()[ii]);
       }
-      Vec3 y = ep[t].response.tail<3>();
-      if (c.frame() == Frame::kTool) y = ep[t].R.transpose() * y;
+      const std::array<double, kPoseDim> unit{1, 1, 1, 1, 1, 1};
+      const Vec3 y = working(ep, t, unit, c.frame() == Frame::kTool ? 1 : 0, c.target(), c.lag()).tail<3>();
       std::array<Vec3, 3> pred;
       for (int r = 0; r < 3; ++r) {
         pred[static_cast<std::size_t>(r)] = rotvec_of(rotation_of(static_cast<RotationRep>(r), v));
@@ -909,7 +940,7 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         for (const auto& ep : eps)
           for (std::size_t t = 0; t < ep.size(); ++t) {
             const double d = drive(ep, t, map.target(), map.lag(), map.permutation()[ii]);
-            sxy += working(ep[t], alpha, f)[i] * d;
+            sxy += working(ep, t, alpha, f, map.target(), map.lag())[i] * d;
             sxx += d * d;
           }
         const double g = sxx > 0 ? std::abs(sxy / sxx) : 0.0;

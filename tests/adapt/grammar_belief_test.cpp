@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -200,6 +201,38 @@ TEST(GrammarBelief, DriveIsTheLaggedRawOrItsDifference) {
   EXPECT_EQ(b.drive(7, 0), 1.0);  // absolute lag 4: 2 − 1
   b.reset();
   EXPECT_EQ(b.drive(4, 0), 0.0);
+}
+
+TEST(GrammarBelief, PerModeObservationsScoreEachModeOnItsOwn) {
+  // the same observation for every mode is update(); a different one for mode 5 changes only mode 5's cells
+  GrammarBelief one(unit_model()), per(unit_model()), moved(unit_model());
+  for (int k = 0; k < 8; ++k) {
+    Action raw = Action::Zero();
+    for (int j = 0; j < kPoseDim; ++j) raw[j] = std::sin(0.7 * k + j);
+    Pose6 obs;
+    for (int j = 0; j < kPoseDim; ++j) obs[j] = std::cos(0.3 * k - j);
+    std::array<Pose6, GrammarBelief::kModes> same;
+    same.fill(obs);
+    one.update(raw, obs);
+    per.update_per_mode(raw, same);
+    same[5] = obs * 2.0;
+    moved.update_per_mode(raw, same);
+  }
+  for (int m = 0; m < GrammarBelief::kModes; ++m)
+    for (int i = 0; i < kPoseDim; ++i)
+      for (int j = 0; j < kPoseDim; ++j)
+        for (int s = 0; s < GrammarBelief::kSigns; ++s)
+          for (int k = 0; k < GrammarBelief::kScales; ++k) {
+            EXPECT_EQ(per.evidence(m, i, j, s, k), one.evidence(m, i, j, s, k));
+            if (m != 5) {
+              EXPECT_EQ(moved.evidence(m, i, j, s, k), one.evidence(m, i, j, s, k));
+            }
+          }
+  EXPECT_NE(moved.evidence(5, 0, 0, 0, 0), one.evidence(5, 0, 0, 0, 0));
+  // one observation per step is the only way into a belief that corrects its scale or re-anchors
+  GrammarBelief anchored(unit_model(), std::nullopt, 10);
+  std::array<Pose6, GrammarBelief::kModes> zeros{};
+  EXPECT_THROW(anchored.update_per_mode(Action::Zero(), zeros), std::logic_error);
 }
 
 TEST(HoldSchedule, ScheduleAndValidation) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # actionshift record and audit end to end: a log of reference_seen contract 0 recorded from the
 # simulator in every format is audited (MISMATCH against identity naming the contract's routing; no
-# MISMATCH against the truth); exit codes 0/1/2/3; bad input is one line naming the file and field.
+# MISMATCH against the truth); the learned backbone's log under a tool-frame absolute contract while
+# its TCP turns; exit codes 0/1/2/3; bad input is one line naming the file and field.
 set -euo pipefail
 AS="$1"
 T="$(mktemp -d)"
@@ -41,6 +42,30 @@ set +e
 set -e
 [ $rc -le 3 ] && [ $rc -ne 2 ] || fail "robomimic audit: exit $rc"
 grep -q "Declared: robomimic env_args controller OSC_POSE; response model: fitted from the log" "$T/robo.txt" || fail "robomimic declaration: $(tail -1 "$T/robo.txt")"
+
+# the learned backbone under a tool-frame absolute contract (reference_unseen_composition c0), the
+# audit benchmark's log whose TCP turns furthest: reading both targets of a step under the current
+# rotation named it base frame with four signs flipped (a wrong MISMATCH against the truth)
+"$AS" record --task pick_cube --split reference_unseen_composition --method oracle --backbone ppo --seed 20260801 \
+  --episodes 20 --contract 0 --out "$T/turn.csv" --truth "$T/turn.truth.json" > /dev/null
+for decl in "$T/turn.truth.json" identity; do
+  set +e
+  "$AS" audit "$T/turn.csv" --task pick_cube --declared "$decl" --json > "$T/turn.json"; rc=$?
+  set -e
+  [ $rc -ne 2 ] || fail "audit of the turning log failed"
+  python3 - "$T/turn.json" "$decl" <<'PY' || fail "the turning log against $decl: $(head -c 600 "$T/turn.json")"
+import json, sys
+a = json.load(open(sys.argv[1]))
+truth = sys.argv[2] != "identity"
+assert a["fields"]["frame"]["identified"] == "tool", a["fields"]["frame"]
+if truth:
+    assert a["status"] != "MISMATCH", a["reason"]
+else:
+    assert a["status"] == "MISMATCH", a["status"]
+    got = a["fields"]["sign"]["identified"].strip("()").split(", ")
+    assert all(g in ("?", t) for g, t in zip(got, ["-1", "1", "-1", "1", "-1", "1"])), got
+PY
+done
 
 # bad input: exit 2, one line, the file and the field named
 printf 'action_0,action_1\n1,2\n' > "$T/bad.csv"

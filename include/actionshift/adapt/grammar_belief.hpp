@@ -95,6 +95,12 @@ class GrammarBelief {
   /// window term); `window_close`: the hold window ends with this step.
   /// `corrector_active`: the scale corrector may learn from this step (false on probe steps).
   void update(const Action& raw, const Pose6& observed, bool hold = false, bool window_close = false, bool corrector_active = true);
+  /// One passive transition whose observation depends on the mode: `observed[m]` scores the cells
+  /// of mode m (the log audit's exact tool-frame coordinates, where which rotation decoded the
+  /// command that moved the robot depends on the lag, and an absolute target is a difference of two
+  /// targets decoded under two rotations). No hold window and no scale corrector; throws
+  /// std::logic_error if the belief runs the corrector or re-anchors.
+  void update_per_mode(const Action& raw, const std::array<Pose6, kModes>& observed);
 
   /// The entropy probe (our variant; the reference runs its factorized belief passive or with fixed
   /// or hold probes only): among the 12 pulses +a·e_0..+a·e_5, −a·e_0..−a·e_5 (gripper 0), the index
@@ -143,6 +149,8 @@ class GrammarBelief {
     return static_cast<std::size_t>((((m * kPoseDim + i) * kPoseDim + j) * kSigns + s) * kScales + k);
   }
   void add_cells(const Pose6& obs, const std::array<Pose6, kModes>& base, const std::array<double, kPoseDim>& sigma);
+  void add_mode_cells(int m, const Pose6& obs, const Pose6& base, const std::array<double, kPoseDim>& sigma);
+  void push_history(const Action& raw);
 
   ResponseModel model_;
   std::array<double, kSigns * kScales> coef_{};
