@@ -257,7 +257,12 @@ struct Step {
   Vec3 pos, next_pos;
   std::optional<double> finger_next;   // mean finger position after the step
   bool first{false};                   // first step of an episode
+  int unit{0};                         // the jackknife's unit: the episode, or a quarter of a log of < 4 episodes
 };
+
+// No single episode decides a field: the units left out one at a time are the episodes, or in a log of
+// fewer than four episodes, each episode cut into equal contiguous parts (four parts or more in all).
+constexpr std::size_t kMinUnits = 4;
 
 std::vector<std::vector<Step>> transitions_of(const ActionLog& log) {
   std::vector<std::vector<Step>> out;
@@ -284,8 +289,16 @@ std::vector<std::vector<Step>> transitions_of(const ActionLog& log) {
     }
     if (!steps.empty()) out.push_back(std::move(steps));
   }
+  const std::size_t parts = out.size() >= kMinUnits ? 1 : (kMinUnits + out.size() - 1) / std::max<std::size_t>(out.size(), 1);
+  int unit = 0;
+  for (auto& ep : out) {
+    for (std::size_t t = 0; t < ep.size(); ++t) ep[t].unit = unit + static_cast<int>(t * parts / ep.size());
+    unit += static_cast<int>(std::min(parts, ep.size()));
+  }
   return out;
 }
+
+int units_of(const std::vector<std::vector<Step>>& eps) { return eps.empty() ? 0 : eps.back().back().unit + 1; }
 
 // the drive of (target, lag) on raw channel j at step t of an episode (zeros before its start)
 double drive(const std::vector<Step>& ep, std::size_t t, Target target, int lag, int j) {
@@ -333,30 +346,37 @@ std::array<double, kPoseDim> isotropic(const std::array<double, kPoseDim>& s) {
   return o;
 }
 
-// the grammar belief's per-cell evidence, summed over episodes, for both frames
+// the grammar belief's per-cell evidence, summed over episodes, for both frames; `per_unit` (if
+// given) receives each jackknife unit's share (the cells are sums over steps)
 Cells evidence(const std::vector<std::vector<Step>>& eps, const std::array<double, kPoseDim>& alpha,
-               const std::array<double, kPoseDim>& sigma) {
+               const std::array<double, kPoseDim>& sigma, std::vector<Cells>* per_unit = nullptr) {
   Cells E(static_cast<std::size_t>(kFrames * kModes * kPoseDim * kPoseDim * kSK), 0.0);
+  if (per_unit) per_unit->assign(static_cast<std::size_t>(units_of(eps)), Cells(E.size(), 0.0));
   adapt::ResponseModel unit{{1, 1, 1, 1, 1, 1}, sigma};
+  const auto add = [&](Cells& out, int f, const adapt::GrammarBelief& b, double sign) {
+    for (int m = 0; m < kModes; ++m)
+      for (int i = 0; i < kPoseDim; ++i)
+        for (int j = 0; j < kPoseDim; ++j)
+          for (int sk = 0; sk < kSK; ++sk) out[cidx(f, m, i, j, sk)] += sign * b.evidence(m, i, j, sk / 7, sk % 7);
+  };
   for (int f = 0; f < kFrames; ++f)
     for (const auto& ep : eps) {
       adapt::GrammarBelief b(unit);
       std::array<Pose6, kModes> y;
       for (std::size_t t = 0; t < ep.size(); ++t) {
+        if (per_unit && (t == 0 || ep[t].unit != ep[t - 1].unit)) add((*per_unit)[static_cast<std::size_t>(ep[t].unit)], f, b, -1.0);
         if (f == 0) {
           b.update(ep[t].raw, working(ep, t, alpha, 0, Target::kDelta, 0));
-          continue;
+        } else {
+          for (int m = 0; m < kModes; ++m) {
+            const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
+            y[static_cast<std::size_t>(m)] = working(ep, t, alpha, 1, mode.target, mode.lag);
+          }
+          b.update_per_mode(ep[t].raw, y);
         }
-        for (int m = 0; m < kModes; ++m) {
-          const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
-          y[static_cast<std::size_t>(m)] = working(ep, t, alpha, 1, mode.target, mode.lag);
-        }
-        b.update_per_mode(ep[t].raw, y);
+        if (per_unit && (t + 1 == ep.size() || ep[t + 1].unit != ep[t].unit)) add((*per_unit)[static_cast<std::size_t>(ep[t].unit)], f, b, 1.0);
       }
-      for (int m = 0; m < kModes; ++m)
-        for (int i = 0; i < kPoseDim; ++i)
-          for (int j = 0; j < kPoseDim; ++j)
-            for (int sk = 0; sk < kSK; ++sk) E[cidx(f, m, i, j, sk)] += b.evidence(m, i, j, sk / 7, sk % 7);
+      add(E, f, b, 1.0);
     }
   return E;
 }
@@ -703,6 +723,10 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   Contract map;
   std::array<double, kPoseDim> sigma_used = isotropic(sigma_n);
   std::array<double, kPoseDim> fit_terms{};  // per channel: mean squared residual / calibrated variance
+  struct {
+    std::array<bool, kPoseDim> perm{}, sign{};
+    bool frame{false}, target{false}, lag{false};
+  } fragile;  // fields whose MAP changes when one episode is left out
   if (commands) {
     P = posterior(evidence(eps, alpha, sigma_used));
     map = contract_of(P, false);
@@ -720,7 +744,28 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     const auto iso = isotropic(inflated);
     R.noise_inflation = std::max(iso[0] / sigma_used[0], iso[3] / sigma_used[3]);
     sigma_used = iso;
-    P = posterior(evidence(eps, alpha, sigma_used));
+    std::vector<Cells> shares;
+    Cells E = evidence(eps, alpha, sigma_used, &shares);
+    P = posterior(E);
+    // No single episode decides a field: in a closed loop one episode's contact or oscillation can
+    // outweigh the rest of a short log (on the simulator a lagged contract's rx sign came out backwards
+    // at 200 transitions, carried by one of four episodes). Each field's MAP is recomputed with each
+    // unit (episode, or quarter of a log of fewer than four) left out; a field that changes is not resolved.
+    if (shares.size() >= 2)
+      for (std::size_t u = 0; u < shares.size(); ++u) {
+        for (std::size_t k = 0; k < E.size(); ++k) E[k] -= shares[u][k];
+        const Posterior Q = posterior(E);
+        for (std::size_t k = 0; k < E.size(); ++k) E[k] += shares[u][k];
+        const auto& qm = adapt::GrammarBelief::modes()[static_cast<std::size_t>(Q.mode)];
+        const auto& pm = adapt::GrammarBelief::modes()[static_cast<std::size_t>(P.mode)];
+        for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i) {
+          if (Q.perm[i] != P.perm[i]) fragile.perm[i] = true;
+          if (Q.perm[i] != P.perm[i] || Q.frame != P.frame || Q.sk[i] / 7 != P.sk[i] / 7) fragile.sign[i] = true;
+        }
+        fragile.frame = fragile.frame || Q.frame != P.frame;
+        fragile.target = fragile.target || qm.target != pm.target;
+        fragile.lag = fragile.lag || qm.lag != pm.lag;
+      }
   }
 
   // a channel whose source is hardly commanded is not resolved, whatever its posterior: in a closed-loop
@@ -729,6 +774,8 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     for (int i = 0; i < kPoseDim; ++i) {
       const auto ii = static_cast<std::size_t>(i);
       if (R.excitation[static_cast<std::size_t>(P.perm[ii])] < o.min_excitation) P.p_perm[ii] = P.p_sign[ii] = P.p_scale[ii] = 0.0;
+      if (fragile.perm[ii]) P.p_perm[ii] = 0.0;
+      if (fragile.perm[ii] || fragile.sign[ii]) P.p_sign[ii] = P.p_scale[ii] = 0.0;
     }
 
   // 4. the gripper: range from the numbers, polarity from the fingers (lag of the grammar's MAP)
@@ -917,6 +964,11 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
                  "; a log that commands every channel, positive and negative, on its own and in reversals, would decide";
       if (f == Field::kSign || f == Field::kPermutation)
         a.reason += "; with the TCP orientation nearly constant, a tool-frame contract equals a base-frame one with other signs and channels, so also rotate the TCP";
+      std::vector<int> one;
+      for (int i : a.unresolved_channels)
+        if (fragile.perm[static_cast<std::size_t>(i)] || (f != Field::kPermutation && fragile.sign[static_cast<std::size_t>(i)])) one.push_back(i);
+      if (!one.empty())
+        a.reason += "; on channel(s) " + channel_list(one) + " one episode decides (leaving it out changes the answer): more episodes would decide";
     }
     return a;
   };
@@ -937,14 +989,33 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
       for (int i = 0; i < kPoseDim; ++i) {
         const auto ii = static_cast<std::size_t>(i);
         double sxy = 0, sxx = 0;
+        std::vector<double> uxy(static_cast<std::size_t>(units_of(eps)), 0.0), uxx(uxy.size(), 0.0);
         for (const auto& ep : eps)
           for (std::size_t t = 0; t < ep.size(); ++t) {
             const double d = drive(ep, t, map.target(), map.lag(), map.permutation()[ii]);
-            sxy += working(ep, t, alpha, f, map.target(), map.lag())[i] * d;
+            const double xy = working(ep, t, alpha, f, map.target(), map.lag())[i] * d;
+            sxy += xy;
             sxx += d * d;
+            uxy[static_cast<std::size_t>(ep[t].unit)] += xy;
+            uxx[static_cast<std::size_t>(ep[t].unit)] += d * d;
           }
         const double g = sxx > 0 ? std::abs(sxy / sxx) : 0.0;
-        const double se = sxx > 0 ? sigma_used[ii] / std::sqrt(sxx) : std::numeric_limits<double>::infinity();
+        // the standard error: the noise model's, or the jackknife's over episodes if larger (a closed
+        // loop's episodes run at different gains: contacts, oscillations under a lag)
+        double se = sxx > 0 ? sigma_used[ii] / std::sqrt(sxx) : std::numeric_limits<double>::infinity();
+        if (uxy.size() >= 2 && sxx > 0) {
+          std::vector<double> gu;
+          for (std::size_t u = 0; u < uxy.size(); ++u)
+            if (sxx - uxx[u] > 0) gu.push_back(std::abs((sxy - uxy[u]) / (sxx - uxx[u])));
+          if (gu.size() == uxy.size()) {
+            double mean = 0, ss = 0;
+            for (double x : gu) mean += x / static_cast<double>(gu.size());
+            for (double x : gu) ss += (x - mean) * (x - mean);
+            se = std::max(se, std::sqrt(ss * static_cast<double>(gu.size() - 1) / static_cast<double>(gu.size())));
+          } else {
+            se = std::numeric_limits<double>::infinity();  // one unit carries all of the channel's drive
+          }
+        }
         const double lo = g / o.gain_tolerance - 2 * se, hi = g * o.gain_tolerance + 2 * se;
         R.scale_band[ii] = {std::max(lo, 0.0), hi};
         std::vector<std::string> in;
@@ -1001,6 +1072,15 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   R.fields.push_back(scalar("target", to_string(dc.target()), commands ? to_string(map.target()) : to_string(dc.target()), p_target,
                             commands, commands ? "delta and absolute targets are not told apart; commands that change from step to step (reversals) would decide" : not_commands,
                             "target encoding differs: declared " + std::string(to_string(dc.target())) + ", the log is " + to_string(map.target())));
+  // a scalar field that one episode decides is not resolved
+  const auto unless_fragile = [&](bool is_fragile) {
+    AuditField& a = R.fields.back();
+    if (!is_fragile || !a.resolved) return;
+    a.resolved = false;
+    a.diff.clear();
+    a.reason = "one episode decides it (leaving it out changes the answer); more episodes would decide";
+  };
+  unless_fragile(fragile.target);
   double spread = 0;
   for (const auto& ep : eps)
     for (const auto& s : ep) spread = std::max(spread, Eigen::AngleAxisd(eps.front().front().R.transpose() * s.R).angle());
@@ -1011,9 +1091,11 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
                                            " rad while translating would decide"
                                      : not_commands,
                             "reference frame differs: declared " + std::string(to_string(dc.frame())) + ", the log is " + to_string(map.frame())));
+  unless_fragile(fragile.frame);
   R.fields.push_back(scalar("lag", std::to_string(dc.lag()), commands ? std::to_string(map.lag()) : std::to_string(dc.lag()), p_lag, commands,
                             commands ? "the actuation lag is not resolved; commands that change abruptly (steps, reversals) would decide" : not_commands,
                             "actuation lag differs: declared " + std::to_string(dc.lag()) + " step(s), the log shows " + std::to_string(map.lag()) + " step(s)"));
+  unless_fragile(fragile.lag);
   const auto grip_words = [](bool inv) { return std::string(inv ? "inverted (+1 closes)" : "not inverted (+1 opens)"); };
   R.fields.push_back(scalar("gripper_inverted", grip_words(dc.gripper_inverted()), grip_words(id.contract.gripper_inverted()),
                             polarity_conf, polarity_checked, polarity_reason,

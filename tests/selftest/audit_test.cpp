@@ -192,6 +192,31 @@ TEST(Audit, ToolFrameAbsoluteTargetsUnderLargeTurns) {
   }
 }
 
+TEST(Audit, NoSingleEpisodeDecidesAField) {
+  // three episodes wired as declared, one (commanded three times harder, so it outweighs them) with
+  // the rx sign flipped: pooled, the log says "rx flipped"; without that episode it does not
+  SyntheticLogOptions calm, loud;
+  calm.episodes = 3;
+  loud.episodes = 1;
+  loud.amplitude = 1.8;
+  loud.seed = 2;
+  ContractFields flipped;
+  flipped.sign = {1, 1, 1, -1, 1, 1};
+  ActionLog log = synthetic_log(conv(Contract::identity()), model(), calm);
+  log.episodes.push_back(synthetic_log(conv(Contract::make(flipped)), model(), loud).episodes.front());
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  EXPECT_EQ(r.status, Status::kInconclusive) << to_text(r);
+  const AuditField& sign = field(r, "sign");
+  EXPECT_FALSE(sign.resolved) << to_text(r);
+  EXPECT_THAT(sign.unresolved_channels, ::testing::Contains(3)) << to_text(r);
+  EXPECT_THAT(sign.reason, HasSubstr("one episode decides")) << to_text(r);
+  // four episodes alike: resolved as before
+  calm.episodes = 4;
+  EXPECT_EQ(audit(synthetic_log(conv(Contract::identity()), model(), calm), o).status, Status::kPass);
+}
+
 TEST(Audit, AnUnmodeledControllerIsNotForcedIntoTheGrammar) {
   // scale 4 on every channel: outside the grammar's grid {0.5 ... 2}
   ContractFields f;
