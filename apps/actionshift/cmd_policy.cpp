@@ -141,11 +141,23 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
     err << "train dp: " << o.task << ", U-Net " << hidden_text(t.down_dims) << " (" << policy::dp_parameter_count(arch)
         << " parameters), " << o.demos << " expert demos, " << o.iterations << " iterations x batch " << o.batch << ", seed "
         << o.seed << "\n";
-    auto result = policy::train_dp(t, [&err, &o](const policy::TrainDpProgress& p) {
+    // the training curve beside the file (the file itself holds no timing, so it re-trains byte for byte)
+    const std::string stem = o.out.size() > 5 && o.out.ends_with(".asdp") ? o.out.substr(0, o.out.size() - 5) : o.out;
+    const std::string curve_path = stem + ".curve.jsonl";
+    std::ostringstream curve;
+    auto result = policy::train_dp(t, [&err, &o, &curve](const policy::TrainDpProgress& p) {
+      curve << nlohmann::json{{"iteration", p.iteration}, {"loss", p.loss}, {"seconds", p.seconds}}.dump() << "\n";
       if (o.progress == "off") return;
       err << "  iteration " << p.iteration << "/" << o.iterations << ": loss " << fmt(p.loss, 5) << ", " << fmt(p.seconds, 1) << " s\n";
     });
     const double per_iteration = result.train_seconds / o.iterations;
+    curve << nlohmann::json{{"command", command},
+                            {"collect_seconds", result.collect_seconds},
+                            {"train_seconds", result.train_seconds},
+                            {"seconds_per_iteration", per_iteration},
+                            {"threads", policy::resolve_threads(t.threads)}}
+                 .dump()
+          << "\n";
     result.weights.training = {{"command", command},
                                {"seed", o.seed},
                                {"algorithm", "DDPM noise prediction on the scripted expert's demonstrations; AdamW, warm-up + cosine, EMA"},
@@ -158,16 +170,15 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
                                {"warmup_steps", t.learn.warmup_steps},
                                {"weight_decay", t.learn.weight_decay},
                                {"ema_max_decay", t.learn.ema_max_decay},
-                               {"final_loss", result.final_loss},
-                               {"collect_seconds", result.collect_seconds},
-                               {"train_seconds", result.train_seconds},
-                               {"seconds_per_iteration", per_iteration}};
+                               {"final_loss", result.final_loss}};
     policy::save_dp(result.weights, o.out);
+    write_file_atomic(curve_path, curve.str());
     const std::string bytes = policy::serialize_dp(result.weights);
     err << "train dp: " << result.demo_successes << "/" << o.demos << " demos kept, " << result.windows << " windows; "
         << fmt(per_iteration, 3) << " s per iteration (batch " << o.batch << ")\n";
     out << "wrote " << o.out << " (" << bytes.size() << " bytes, " << result.weights.params.size() << " parameters, sha256 "
-        << sha256_hex(bytes) << ") in " << fmt(result.collect_seconds + result.train_seconds, 1) << " s; backbone dp:" << o.out << "\n";
+        << sha256_hex(bytes) << ") and " << curve_path << " in " << fmt(result.collect_seconds + result.train_seconds, 1)
+        << " s; backbone dp:" << o.out << "\n";
     return 0;
   } catch (const std::invalid_argument& e) {
     err << "actionshift: error: " << e.what() << "\n";
