@@ -165,7 +165,7 @@ int record(const RecordOptions& o) {
     c.contract = truth;
     nlohmann::json j = c.to_json_value();
     j["recorded"] = {{"job_id", eval::job_id(job)}, {"split", job.split.name}, {"contract_index", o.contract}};
-    weight_file::write_atomic(o.truth, j.dump(2) + "\n");
+    write_file_atomic(o.truth, j.dump(2) + "\n");
   }
   nlohmann::json line{{"log", o.out},          {"job_id", eval::job_id(job)}, {"contract_index", o.contract},
                       {"episodes", recorded},  {"success_once", successes},   {"transitions", log.transitions()},

@@ -1,4 +1,5 @@
 // validate, contract hash/decode/encode, splits generate.
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/decoder.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
@@ -290,17 +291,7 @@ int run_splits_generate(const SplitsGenerateOptions& o) {
   for (const auto& r : rules) {
     const Manifest m = splits::generate(r, o.seed);
     const fs::path path = fs::path(o.out_dir) / (r + ".json");
-    require_replaceable_output(path.string());  // a directory, FIFO or device of that name is not replaced
-    const fs::path tmp = path.string() + ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      out << m.serialize();
-      if (!out) throw InputError(tmp.string(), "", "cannot write file");
-    }
-    if (fs::rename(tmp, path, ec); ec) {
-      fs::remove(tmp, ec);
-      throw InputError(path.string(), "--out", "cannot replace file: " + ec.message());
-    }
+    write_file_atomic(path.string(), m.serialize());  // a directory, FIFO or device of that name is not replaced
     std::cout << path.string() << "  " << (m.is_pool() ? "pool " : "split ") << m.test().size() << " contracts  manifest_sha256 "
               << m.manifest_sha256() << "\n";
   }

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 
 #include "actionshift/adapt/plugin.hpp"
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -465,11 +466,7 @@ int run_plan(const PlanOptions& o, const eval::PlanResolver& resolver, std::ostr
       const std::string submit_path = stem + ".submit.sh";
       ensure_parent(script_path);
       const auto write_script = [](const std::string& path, const std::string& text) {
-        {
-          std::ofstream f(path, std::ios::binary | std::ios::trunc);
-          f << text;
-          if (!f) throw InputError(path, "", "cannot write Slurm script");
-        }
+        write_file_atomic(path, text);
         std::error_code pe;
         fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add, pe);
       };

@@ -1,6 +1,7 @@
 #include "cmd_identifier.hpp"
 
 #include "actionshift/adapt/identifier.hpp"
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/input_file.hpp"
@@ -81,9 +82,7 @@ int run_train_identifier(const TrainIdentifierCliOptions& o, std::ostream& out, 
                         {"parameters", result.weights.parameter_count()},
                         {"wall_seconds", std::round(result.wall_seconds * 10) / 10},
                         {"heldout", result.heldout.to_json()}};
-    std::ofstream f(o.verdicts);
-    f << v.dump(2) << "\n";
-    if (!f) throw InputError(o.verdicts, "", "cannot write file");
+    write_file_atomic(o.verdicts, v.dump(2) + "\n");
   }
   out << "wrote " << path << " (" << bytes.size() << " bytes, " << result.weights.parameter_count() << " parameters, sha256 " << sha
       << ") in " << std::fixed << std::setprecision(1) << result.wall_seconds << " s\n";

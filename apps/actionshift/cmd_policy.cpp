@@ -4,6 +4,7 @@
 
 #include "cmd_eval.hpp"
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/input_file.hpp"
@@ -30,17 +31,6 @@ std::string fmt(double x, int digits = 3) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(digits) << x;
   return s.str();
-}
-
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::trunc);
-    if (!f) throw InputError(path, "", "cannot write");
-    f << text;
-    if (!f) throw InputError(path, "", "write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError(path, "", "cannot rename temporary file");
 }
 
 std::vector<int> parse_hidden(const std::string& text);

@@ -4,6 +4,7 @@
 #include "actionshift/adapt/plugin.hpp"
 #include "actionshift/eval/external_method.hpp"
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -216,19 +217,7 @@ int run_calibrate(const CalibrateOptions& o) {
     std::error_code ec;
     if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path(), ec);
     if (ec) throw InputError(o.out, "--out", "cannot create the parent directory: " + ec.message());
-    const std::string tmp = o.out + ".tmp";
-    bool written = false;
-    {
-      std::ofstream f(tmp, std::ios::binary);
-      f << c.to_json() << "\n";
-      f.flush();
-      written = static_cast<bool>(f);
-    }
-    if (written) std::filesystem::rename(tmp, o.out, ec);
-    if (!written || ec) {
-      std::filesystem::remove(tmp, ec);  // never leave the temporary file behind
-      throw InputError(o.out, "--out", written ? "cannot rename the temporary file into place" : "cannot write the file");
-    }
+    write_file_atomic(o.out, c.to_json() + "\n");
   }
   if (o.json) {
     std::cout << c.to_json() << "\n";

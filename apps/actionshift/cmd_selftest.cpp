@@ -3,6 +3,7 @@
 #include "cmd_selftest.hpp"
 
 #include "actionshift/adapt/calibration.hpp"
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -155,21 +156,7 @@ int calibrate_misspec(const SelftestOptions& o, const selftest::Options& base, c
   if (std::filesystem::is_regular_file(o.calibrate_misspec, ec)) all = parse_json_input(read_text(o.calibrate_misspec, "a misspecification file"), o.calibrate_misspec);
   if (!all.is_object()) throw InputError(o.calibrate_misspec, "", "expected a JSON object of tasks");
   all[o.task] = entry;
-  const std::string tmp = o.calibrate_misspec + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << all.dump(2) << "\n";
-    f.flush();
-    if (!f) {
-      std::filesystem::remove(tmp, ec);
-      throw InputError(o.calibrate_misspec, "--calibrate-misspec", "cannot write the file");
-    }
-  }
-  std::filesystem::rename(tmp, o.calibrate_misspec, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(o.calibrate_misspec, "--calibrate-misspec", "cannot rename the temporary file into place");
-  }
+  write_file_atomic(o.calibrate_misspec, all.dump(2) + "\n");
   std::cout << "misspecification thresholds for " << o.task << ": " << summary << "; " << misidentified
             << " runs misidentified, " << cut_short << " cut short; written to " << o.calibrate_misspec << "\n";
   return 0;

@@ -202,7 +202,7 @@ IdentifierWeights parse_identifier(std::string_view bytes, const std::string& so
   return w;
 }
 
-void save_identifier(const IdentifierWeights& w, const std::string& path) { weight_file::write_atomic(path, serialize_identifier(w)); }
+void save_identifier(const IdentifierWeights& w, const std::string& path) { write_file_atomic(path, serialize_identifier(w)); }
 
 IdentifierWeights load_identifier(const std::string& path) {
   return parse_identifier(weight_file::read(path, kMaxFileBytes, "identifier weight file"), path);

@@ -18,36 +18,6 @@ std::string read_file(const std::string& path, const std::string& what, std::uin
   return read_input_file(path, what, max_bytes);
 }
 
-void atomic_write(const std::string& path, std::string_view bytes) {
-  require_replaceable_output(path);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw InputError(tmp, "", std::string("cannot create file: ") + std::strerror(errno));
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int e = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw InputError(tmp, "", std::string("write failed: ") + std::strerror(e));
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  // the data must be on disk before the rename makes it visible under the final name
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const int e = errno;
-    ::unlink(tmp.c_str());
-    throw InputError(tmp, "", std::string("fsync/close failed: ") + std::strerror(e));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(tmp.c_str());
-    throw InputError(path, "", std::string("rename failed: ") + std::strerror(e));
-  }
-}
-
 bool is_token(std::string_view s) {
   if (s.empty() || s.size() > 128) return false;
   for (std::size_t i = 0; i < s.size(); ++i) {

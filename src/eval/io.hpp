@@ -1,5 +1,5 @@
 #pragma once
-// private helpers of the eval layer: whole-file reads, atomic writes, small checks
+// private helpers of the eval layer: whole-file reads, small checks
 
 #include "actionshift/core/input_file.hpp"
 
@@ -13,9 +13,6 @@ namespace actionshift::eval::detail {
 // throws InputError(path, "", reason) naming `what` if it cannot be read or is too large
 std::string read_file(const std::string& path, const std::string& what = "an input file",
                       std::uintmax_t max_bytes = kMaxInputFileBytes);
-
-// write `bytes` to `path` atomically: `<path>.tmp.<pid>` is written, fsynced and renamed over `path`
-void atomic_write(const std::string& path, std::string_view bytes);
 
 // true for a name made of [a-z0-9_.-] that starts with a letter or digit (tasks, splits, methods)
 bool is_token(std::string_view s);

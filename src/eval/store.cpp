@@ -2,6 +2,7 @@
 
 #include "actionshift/eval/resolve.hpp"
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
@@ -537,7 +538,7 @@ nlohmann::json make_job_summary(const JobSpec& job, const std::vector<EpisodeRec
 }
 
 void write_json_atomic(const std::string& path, const nlohmann::json& value) {
-  detail::atomic_write(path, value.dump(2) + "\n");
+  write_file_atomic(path, value.dump(2) + "\n");
 }
 
 }  // namespace actionshift::eval

@@ -139,7 +139,7 @@ DpWeights parse_dp(std::string_view bytes, const std::string& source) {
   return w;
 }
 
-void save_dp(const DpWeights& w, const std::string& path) { weight_file::write_atomic(path, serialize_dp(w)); }
+void save_dp(const DpWeights& w, const std::string& path) { write_file_atomic(path, serialize_dp(w)); }
 
 DpWeights load_dp(const std::string& path) { return parse_dp(weight_file::read(path, kMaxFileBytes, "weight file"), path); }
 

@@ -185,7 +185,7 @@ MlpWeights parse_mlp(std::string_view bytes, const std::string& source) {
   return w;
 }
 
-void save_mlp(const MlpWeights& w, const std::string& path) { weight_file::write_atomic(path, serialize_mlp(w)); }
+void save_mlp(const MlpWeights& w, const std::string& path) { write_file_atomic(path, serialize_mlp(w)); }
 
 MlpWeights load_mlp(const std::string& path) { return parse_mlp(weight_file::read(path, kMaxFileBytes, "weight file"), path); }
 

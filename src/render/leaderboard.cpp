@@ -3,6 +3,7 @@
 
 #include "actionshift/adapt/plugin.hpp"
 #include "actionshift/adapt/registry.hpp"
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/input_file.hpp"
 #include "actionshift/core/json_input.hpp"
@@ -68,13 +69,7 @@ std::pair<std::string, std::string> rung_of(const std::string& label, const std:
   return declared_rung(dirs, jobs);
 }
 
-void write_text(const fs::path& p, const std::string& text) {
-  require_replaceable_output(p.string());
-  std::ofstream f(p, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
-  if (!f) throw InputError(p.string(), "--out", "cannot write file");
-}
+void write_text(const fs::path& p, const std::string& text) { write_file_atomic(p.string(), text); }
 
 std::string md_cell(const std::string& s) {
   std::string out;

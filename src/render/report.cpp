@@ -3,6 +3,7 @@
 #include "actionshift/render/report.hpp"
 #include "xml_escape.hpp"
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/vocabulary.hpp"
 #include "actionshift/eval/summary.hpp"
@@ -38,12 +39,7 @@ json read_json(const fs::path& p) {
   return j;
 }
 
-void write_text(const fs::path& p, const std::string& text) {
-  std::ofstream f(p, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
-  if (!f) throw InputError(p.string(), "--out", "cannot write file");
-}
+void write_text(const fs::path& p, const std::string& text) { write_file_atomic(p.string(), text); }
 
 std::string str_field(const json& j, const char* key, const std::string& fallback = "-") {
   if (!j.is_object() || !j.contains(key)) return fallback;

@@ -410,7 +410,7 @@ void write_log_maniskill(const ActionLog& log, const std::string& path, const st
     side["episodes"].push_back({{"episode_id", e}, {"control_mode", control_mode}, {"elapsed_steps", log.episodes[e].actions.size()}});
   std::filesystem::path p(path);
   p.replace_extension(".json");
-  weight_file::write_atomic(p.string(), side.dump(2) + "\n");
+  write_file_atomic(p.string(), side.dump(2) + "\n");
 }
 
 void write_log_robomimic(const ActionLog& log, const std::string& path, const std::string& controller) {

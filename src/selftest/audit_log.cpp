@@ -264,7 +264,7 @@ void write_log_csv(const ActionLog& log, const std::string& path) {
       out += "\n";
     }
   }
-  weight_file::write_atomic(path, out);
+  write_file_atomic(path, out);
 }
 
 void write_log_jsonl(const ActionLog& log, const std::string& path) {
@@ -290,7 +290,7 @@ void write_log_jsonl(const ActionLog& log, const std::string& path) {
       out += j.dump() + "\n";
     }
   }
-  weight_file::write_atomic(path, out);
+  write_file_atomic(path, out);
 }
 
 // ---- synthetic log

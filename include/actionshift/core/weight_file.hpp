@@ -5,6 +5,7 @@
 /// (little-endian float32s, whose SHA-256 the header records as `payload_sha256`). Reading checks
 /// the frame and returns the header and the payload; what the payload holds is the caller's.
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/input_file.hpp"
@@ -92,20 +93,6 @@ inline void check_payload(const Unframed& u, std::int64_t floats, const std::str
 /// oversized or unreadable file.
 inline std::string read(const std::string& path, std::uintmax_t max_bytes, const std::string& what) {
   return read_input_file(path, what, max_bytes);
-}
-
-/// Writes `bytes` to `path` through a temporary file renamed over it (readers never see half a
-/// file). Throws std::runtime_error naming the path.
-inline void write_atomic(const std::string& path, std::string_view bytes) {
-  require_replaceable_output(path);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(path + ": cannot write");
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw std::runtime_error(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename temporary file");
 }
 
 }  // namespace actionshift::weight_file
