@@ -92,55 +92,37 @@ int run_train_bc(TrainBcOptions o, std::ostream& out, std::ostream& err) {
 
 int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& err) {
   try {
-    policy::TrainDpOptions t;
+    policy::TrainDpOptions t = o.dp;
     t.task = sim::parse_task(o.task);
-    (void)sim::profile_config(o.profile);  // validates the name
-    t.profile = o.profile;
-    t.seed = o.seed;
-    t.demos = o.demos;
-    t.iterations = o.iterations;
-    t.batch_size = o.batch;
-    t.ddim_steps = o.ddim_steps;
-    t.learn.learning_rate = o.learning_rate;
-    t.threads = o.threads;
-    if (o.demos <= 0 || o.iterations <= 0 || o.batch <= 0)
-      throw InputError("", "train dp", "--demos, --iterations and --batch must be positive");
-    if (!(o.learning_rate > 0) || !std::isfinite(o.learning_rate)) throw InputError("", "lr", "must be positive");
     try {
       t.down_dims = parse_hidden(o.down_dims);
     } catch (const InputError& e) {
       throw InputError("", "down-dims", e.reason());
     }
+    policy::check_train_dp_options(t);
     policy::DpArch arch;
     arch.obs_dim = sim::observation_layout(t.task).size();
     arch.down_dims = t.down_dims;
-    try {
-      arch.validate();
-    } catch (const std::invalid_argument& e) {
-      throw InputError("", "down-dims", e.what());
-    }
-    if (o.ddim_steps < 0 || o.ddim_steps > arch.diffusion_steps)
-      throw InputError("", "ddim-steps", "must be in [0, " + std::to_string(arch.diffusion_steps) + "] (0: DDPM)");
     if (o.out.empty()) throw InputError("", "out", "a weight file is required (the backbone is then dp:FILE)");
     require_writable_output(o.out);
     if (o.progress != "off") (void)parse_progress_mode(o.progress);  // validates the mode
-    const std::string command = "actionshift train dp --task " + o.task + " --seed " + std::to_string(o.seed) + " --demos " +
-                                std::to_string(o.demos) + " --iterations " + std::to_string(o.iterations) + " --batch " +
-                                std::to_string(o.batch) + " --down-dims " + o.down_dims + " --ddim-steps " +
-                                std::to_string(o.ddim_steps) + " --lr " + fmt(o.learning_rate, 8) + " --profile " + o.profile;
+    const std::string command = "actionshift train dp --task " + o.task + " --seed " + std::to_string(t.seed) + " --demos " +
+                                std::to_string(t.demos) + " --iterations " + std::to_string(t.iterations) + " --batch " +
+                                std::to_string(t.batch_size) + " --down-dims " + o.down_dims + " --ddim-steps " +
+                                std::to_string(t.ddim_steps) + " --lr " + fmt(t.learn.learning_rate, 8) + " --profile " + t.profile;
     err << "train dp: " << o.task << ", U-Net " << hidden_text(t.down_dims) << " (" << policy::dp_parameter_count(arch)
-        << " parameters), " << o.demos << " expert demos, " << o.iterations << " iterations x batch " << o.batch << ", seed "
-        << o.seed << "\n";
+        << " parameters), " << t.demos << " expert demos, " << t.iterations << " iterations x batch " << t.batch_size << ", seed "
+        << t.seed << "\n";
     // the training curve beside the file (the file itself holds no timing, so it re-trains byte for byte)
     const std::string stem = o.out.size() > 5 && o.out.ends_with(".asdp") ? o.out.substr(0, o.out.size() - 5) : o.out;
     const std::string curve_path = stem + ".curve.jsonl";
     std::ostringstream curve;
-    auto result = policy::train_dp(t, [&err, &o, &curve](const policy::TrainDpProgress& p) {
+    auto result = policy::train_dp(t, [&err, &o, &t, &curve](const policy::TrainDpProgress& p) {
       curve << nlohmann::json{{"iteration", p.iteration}, {"loss", p.loss}, {"seconds", p.seconds}}.dump() << "\n";
       if (o.progress == "off") return;
-      err << "  iteration " << p.iteration << "/" << o.iterations << ": loss " << fmt(p.loss, 5) << ", " << fmt(p.seconds, 1) << " s\n";
+      err << "  iteration " << p.iteration << "/" << t.iterations << ": loss " << fmt(p.loss, 5) << ", " << fmt(p.seconds, 1) << " s\n";
     });
-    const double per_iteration = result.train_seconds / o.iterations;
+    const double per_iteration = result.train_seconds / t.iterations;
     curve << nlohmann::json{{"command", command},
                             {"collect_seconds", result.collect_seconds},
                             {"train_seconds", result.train_seconds},
@@ -149,14 +131,14 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
                  .dump()
           << "\n";
     result.weights.training = {{"command", command},
-                               {"seed", o.seed},
+                               {"seed", t.seed},
                                {"algorithm", "DDPM noise prediction on the scripted expert's demonstrations; AdamW, warm-up + cosine, EMA"},
-                               {"demos", o.demos},
+                               {"demos", t.demos},
                                {"demo_successes", result.demo_successes},
                                {"windows", result.windows},
-                               {"iterations", o.iterations},
-                               {"batch_size", o.batch},
-                               {"learning_rate", o.learning_rate},
+                               {"iterations", t.iterations},
+                               {"batch_size", t.batch_size},
+                               {"learning_rate", t.learn.learning_rate},
                                {"warmup_steps", t.learn.warmup_steps},
                                {"weight_decay", t.learn.weight_decay},
                                {"ema_max_decay", t.learn.ema_max_decay},
@@ -164,8 +146,8 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
     policy::save_dp(result.weights, o.out);
     write_file_atomic(curve_path, curve.str());
     const std::string bytes = policy::serialize_dp(result.weights);
-    err << "train dp: " << result.demo_successes << "/" << o.demos << " demos kept, " << result.windows << " windows; "
-        << fmt(per_iteration, 3) << " s per iteration (batch " << o.batch << ")\n";
+    err << "train dp: " << result.demo_successes << "/" << t.demos << " demos kept, " << result.windows << " windows; "
+        << fmt(per_iteration, 3) << " s per iteration (batch " << t.batch_size << ")\n";
     out << "wrote " << o.out << " (" << bytes.size() << " bytes, " << result.weights.params.size() << " parameters, sha256 "
         << sha256_hex(bytes) << ") and " << curve_path << " in " << fmt(result.collect_seconds + result.train_seconds, 1)
         << " s; backbone dp:" << o.out << "\n";

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 
+#include "actionshift/policy/dp.hpp"
 #include "actionshift/policy/gate0.hpp"
 #include "actionshift/policy/ppo.hpp"
 #include "actionshift/policy/train.hpp"
@@ -53,18 +54,14 @@ int run_train_ppo(TrainPpoOptions options, std::ostream& out = std::cout, std::o
 //  [--down-dims 32,64,128] [--ddim-steps N] [--lr X] [--threads N] [--progress M]`: a Diffusion Policy
 // (policy/dp.hpp) from the scripted expert's demonstrations; the file is the backbone dp:FILE
 struct TrainDpCliOptions {
-  std::string task;                 // --task
-  std::string profile{"maniskill"}; // --profile
-  std::uint64_t seed{20260718};     // --seed
-  int demos{100};                   // --demos expert episodes
-  int iterations{1000};             // --iterations optimiser steps
-  int batch{64};                    // --batch
+  /// Bound directly: --profile, --seed, --demos, --iterations, --batch (batch_size), --ddim-steps,
+  /// --lr (learn.learning_rate), --threads; checked once, by policy::check_train_dp_options. `task` and
+  /// `down_dims` are set from the options below.
+  policy::TrainDpOptions dp;
+  std::string task;                    // --task
   std::string down_dims{"32,64,128"};  // --down-dims U-Net widths, comma separated
-  int ddim_steps{0};                // --ddim-steps sampler of the policy (0: DDPM, 100 steps)
-  double learning_rate{1e-4};       // --lr AdamW peak step size
-  unsigned threads{0};              // --threads (0: all cores)
-  std::string out;                  // --out FILE (.asdp)
-  std::string progress{"auto"};     // --progress auto|bar|lines|off
+  std::string out;                     // --out FILE (.asdp)
+  std::string progress{"auto"};        // --progress auto|bar|lines|off
 };
 int run_train_dp(const TrainDpCliOptions& options, std::ostream& out = std::cout, std::ostream& err = std::cerr);
 

@@ -1,6 +1,7 @@
 // Diffusion Policy: demonstrations from the scripted expert and the training loop (dp.hpp)
 #include "actionshift/policy/dp.hpp"
 
+#include "actionshift/core/error.hpp"
 #include "actionshift/core/workers.hpp"
 #include "actionshift/policy/expert.hpp"
 #include "actionshift/sim/env.hpp"
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace actionshift::policy {
@@ -25,16 +27,36 @@ struct Demo {
 
 }  // namespace
 
+void check_train_dp_options(const TrainDpOptions& o) {
+  if (o.demos <= 0) throw InputError("", "demos", "must be positive");
+  if (o.iterations <= 0) throw InputError("", "iterations", "must be positive");
+  if (o.batch_size <= 0) throw InputError("", "batch", "must be positive");
+  if (o.log_every <= 0) throw InputError("", "log-every", "must be positive");
+  if (!(o.learn.learning_rate > 0) || !std::isfinite(o.learn.learning_rate)) throw InputError("", "lr", "must be positive");
+  try {
+    (void)sim::profile_config(o.profile);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", "profile", e.what());
+  }
+  DpArch arch;
+  arch.obs_dim = sim::observation_layout(o.task).size();
+  arch.down_dims = o.down_dims;
+  try {
+    arch.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", "down-dims", e.what());
+  }
+  if (o.ddim_steps < 0 || o.ddim_steps > arch.diffusion_steps)
+    throw InputError("", "ddim-steps", "must be in [0, " + std::to_string(arch.diffusion_steps) + "] (0: DDPM)");
+}
+
 TrainDpResult train_dp(const TrainDpOptions& o, const std::function<void(const TrainDpProgress&)>& progress) {
-  if (o.demos <= 0 || o.iterations <= 0 || o.batch_size <= 0 || o.log_every <= 0)
-    throw std::invalid_argument("train_dp: demos, iterations, batch size and log period must be positive");
+  check_train_dp_options(o);
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   DpArch arch;
   arch.obs_dim = sim::observation_layout(o.task).size();
   arch.down_dims = o.down_dims;
-  arch.validate();
-  if (o.ddim_steps < 0 || o.ddim_steps > arch.diffusion_steps) throw std::invalid_argument("train_dp: ddim_steps out of range");
   const unsigned threads = resolve_threads(o.threads);
 
   // demonstrations, in parallel, stored by episode index

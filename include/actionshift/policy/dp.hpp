@@ -287,6 +287,13 @@ struct TrainDpOptions {
   int log_every{50};                       ///< progress callback period (iterations)
 };
 
+/// The checks train_dp makes before it starts (the CLI makes them before it writes anything): demos,
+/// iterations, batch size and log period positive, the learning rate positive and finite, the
+/// profile known, the U-Net widths valid for the task (DpArch::validate), ddim_steps in [0, 100].
+/// Messages name the fields as the `train dp` options spell them ("down-dims: ..."). Throws
+/// actionshift::InputError.
+void check_train_dp_options(const TrainDpOptions& options);
+
 /// Progress of `train dp`.
 struct TrainDpProgress {
   int iteration{0};       ///< optimiser steps done
