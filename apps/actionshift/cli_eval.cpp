@@ -227,8 +227,8 @@ void register_eval_commands(CLI::App& app, CliContext& ctx) {
                         "wrapper does, 63 samples each), reference_walk (the same walks without the reset) or\n"
                         "episodes (task episodes with resets, capped at the horizon)")
       ->capture_default_str();
-  calibrate->add_option("--episodes", cal_o.episodes, "Random walks (maniskill_walk, reference_walk) or episodes; 1 to 100000")->check(CLI::Range(1, 100000))->capture_default_str();
-  calibrate->add_option("--steps", cal_o.steps, "Steps per walk or episode (at least 2: a response needs two poses)")
+  calibrate->add_option("--episodes", cal_o.calibration.episodes, "Random walks (maniskill_walk, reference_walk) or episodes; 1 to 100000")->check(CLI::Range(1, 100000))->capture_default_str();
+  calibrate->add_option("--steps", cal_o.calibration.steps, "Steps per walk or episode (at least 2: a response needs two poses)")
       ->capture_default_str()
       ->check(CLI::Range(2, 1000000));
   calibrate->add_option("--ik", cal_o.ik, "Ablation: override the profile's IK: single_step or converged");
@@ -236,7 +236,7 @@ void register_eval_commands(CLI::App& app, CliContext& ctx) {
   calibrate->add_option("--solver-iterations", cal_o.solver_iterations,
                         "Ablation: Bullet solver iterations per step, 1..1000 (default: the profile's, 15)");
   calibrate->add_option("--joint-limits", cal_o.joint_limits, "Ablation: arm joint limit constraints on or off");
-  calibrate->add_option("--seed", cal_o.seed, "Seed")->check(kSeed)->capture_default_str();
+  calibrate->add_option("--seed", cal_o.calibration.seed, "Seed")->check(kSeed)->capture_default_str();
   calibrate->add_option("--obs-noise", cal_o.obs_noise,
                         "Measure under observation noise of this sigma (as run --obs-noise; off by default); the\n"
                         "calibration's profile label gets [obs_noise=S]")
@@ -244,7 +244,7 @@ void register_eval_commands(CLI::App& app, CliContext& ctx) {
   calibrate->add_option("--out", cal_o.out, "Write the calibration JSON here (e.g. configs/calibration/<profile>/<task>.json)");
   calibrate->add_flag("--json", cal_o.json, "Print the calibration JSON");
   add_robot_options(calibrate, cal_o.robot);
-  calibrate->add_flag("--gripper-channel", cal_o.gripper_channel,
+  calibrate->add_flag("--gripper-channel", cal_o.calibration.gripper_channel,
                       "Also fit the finger channel (gripper action vs mean finger-position change per step), which\n"
                       "grammar_belief uses with {\"gripper_channel\":true}; adds the optional \"gripper\" key");
   calibrate->callback([&] { ctx.action = [&] { return cli::run_calibrate(cal_o); }; });

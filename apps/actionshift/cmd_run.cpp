@@ -201,16 +201,12 @@ int run_calibrate(const CalibrateOptions& o) {
   if (!overrides.empty()) cfg.profile += "[" + overrides + "]";
   const auto robot = load_cli_robot(o.robot);
   const auto model = sim::EnvModel::make(sim::parse_task(o.task), cfg, robot ? robot->description : nullptr);
-  eval::CalibrationOptions co;
+  eval::CalibrationOptions co = o.calibration;
   try {
     co.protocol = eval::parse_protocol(o.protocol);
   } catch (const std::invalid_argument& e) {
     throw InputError("", "--protocol", e.what());
   }
-  co.episodes = o.episodes;
-  co.steps = o.steps;
-  co.seed = o.seed;
-  co.gripper_channel = o.gripper_channel;
   const adapt::ResponseCalibration c = eval::calibrate(model, co);
   if (!o.out.empty()) {
     const std::filesystem::path p(o.out);

@@ -5,6 +5,7 @@
 #include "cmd_eval.hpp"
 #include "commands.hpp"
 
+#include "actionshift/eval/calibrate.hpp"
 #include "actionshift/eval/episode_fn.hpp"
 #include "actionshift/eval/plan_expand.hpp"
 #include "actionshift/sim/robot_source.hpp"
@@ -54,12 +55,12 @@ std::optional<eval::RobotRef> cli_robot_ref(const RobotOptions& o);
 
 // `actionshift calibrate --task T [--episodes N] [--steps N] [--seed S] [--out FILE] [--json]`
 struct CalibrateOptions {
+  /// Bound directly: --episodes, --steps, --seed, --gripper-channel (checked by eval::calibrate);
+  /// `protocol` is set from the option below.
+  eval::CalibrationOptions calibration;
   std::string task;
   std::string profile{"maniskill"};
   std::string protocol{"maniskill_walk"};
-  int episodes{8};
-  int steps{64};
-  std::uint64_t seed{20260720};
   // ablation overrides of the profile ("" = the profile's own setting); the calibration's profile
   // label then names them, e.g. "maniskill[ik=converged]"
   std::string ik;                    // single_step | converged
@@ -69,7 +70,6 @@ struct CalibrateOptions {
   std::string out;   // write the calibration JSON here ("" → print it only)
   bool json{false};  // print the calibration JSON instead of the table
   RobotOptions robot;  // --robot/--package
-  bool gripper_channel{false};  // also fit the finger channel (optional "gripper" key)
   double obs_noise{0.0};        // --obs-noise: observation-noise sigma (label "[obs_noise=S]" on the profile)
 };
 int run_calibrate(const CalibrateOptions& o);
