@@ -70,10 +70,10 @@ void register_selftest_commands(CLI::App& app, CliContext& ctx) {
   audit->add_option("--task", audit_o.task, "Use this task's built-in calibration (pick_cube, ...)")->excludes(audit_cal);
   audit->add_option("--profile", audit_o.profile, "With --task: the simulator profile of the calibration")->check(kProfile)
       ->capture_default_str();
-  audit->add_option("--confidence-floor", audit_o.confidence_floor, "Posterior mass a field needs to be resolved")->capture_default_str();
-  audit->add_option("--misspec-ratio", audit_o.misspec_ratio, "Abstain when the best contract fits worse than this x the calibrated noise variance")
+  audit->add_option("--confidence-floor", audit_o.audit.confidence_floor, "Posterior mass a field needs to be resolved")->capture_default_str();
+  audit->add_option("--misspec-ratio", audit_o.audit.misspec_ratio, "Abstain when the best contract fits worse than this x the calibrated noise variance")
       ->capture_default_str();
-  audit->add_option("--gain-tolerance", audit_o.gain_tolerance,
+  audit->add_option("--gain-tolerance", audit_o.audit.gain_tolerance,
                     "Factor by which a log's response gain may differ from the calibrated one (scale is the set of grid\n"
                     "values within it)")->capture_default_str();
   audit->add_option("--max-steps", audit_o.max_steps, "Audit only the first N transitions");

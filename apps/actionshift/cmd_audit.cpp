@@ -49,7 +49,7 @@ int audit(const AuditCliOptions& o) {
     if (*o.max_steps < 1) throw InputError("command line", "--max-steps", "must be >= 1");
     log = log.head(static_cast<std::size_t>(*o.max_steps));
   }
-  selftest::AuditOptions ao;
+  selftest::AuditOptions ao = o.audit;
   std::string declared_from = "default (identity)";
   if (!o.declared.empty()) {
     ao.declared = resolve_declared(o.declared);
@@ -86,9 +86,6 @@ int audit(const AuditCliOptions& o) {
     ao.model = adapt::ResponseCalibration::from_json(std::string(*text), "built-in calibration " + o.profile + "/" + o.task).model();
     model_from = "built-in calibration " + o.profile + "/" + o.task;
   }
-  ao.confidence_floor = o.confidence_floor;
-  ao.misspec_ratio = o.misspec_ratio;
-  ao.gain_tolerance = o.gain_tolerance;
   if (const std::string err = selftest::validate(ao); !err.empty()) throw InputError("command line", "", err);
   const selftest::AuditResult r = selftest::audit(log, ao);
   if (o.json) {

@@ -7,6 +7,8 @@
 #include "cmd_run.hpp"
 #include "commands.hpp"
 
+#include "actionshift/selftest/audit.hpp"
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -16,6 +18,9 @@ namespace actionshift::cli {
 inline constexpr int kAuditInconclusive = 3;  ///< audit's exit code for INCONCLUSIVE (2 is bad input)
 
 struct AuditCliOptions {
+  /// Bound directly: --confidence-floor, --misspec-ratio, --gain-tolerance (checked once, by
+  /// selftest::validate). `declared` and `model` are set from the options below.
+  selftest::AuditOptions audit;
   std::string log;                    ///< LOG: .csv, .jsonl, .h5/.hdf5 (ManiSkill or robomimic layout)
   std::string declared;               ///< --declared: contract argument or conventions JSON (file or inline); "" → the file's own, else identity
   std::string rotation;               ///< --rotation: axis_angle | euler_xyz | euler_zyx (overrides the declaration's)
@@ -24,9 +29,6 @@ struct AuditCliOptions {
   std::string calibration;            ///< --calibration FILE (response model)
   std::string task;                   ///< --task T: the task's built-in calibration
   std::string profile{"maniskill"};   ///< --profile: with --task
-  double confidence_floor{0.99};
-  double misspec_ratio{25.0};
-  double gain_tolerance{1.8};
   std::optional<long long> max_steps; ///< --max-steps N: audit only the first N transitions
   bool json{false};
 };
