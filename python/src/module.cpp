@@ -12,6 +12,7 @@
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/manifest.hpp"
+#include "actionshift/core/workers.hpp"
 #include "actionshift/core/transforms.hpp"
 #include "actionshift/core/validate.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
@@ -616,78 +617,6 @@ class PyEnv {
   std::optional<RenderSetup> render_;
   render::Camera camera_;
   std::unique_ptr<render::Renderer> renderer_;     // made at the first render()
-};
-
-// A fixed set of worker threads that run a function over [0, n) in chunks; the caller waits.
-class WorkerPool {
- public:
-  explicit WorkerPool(unsigned threads) {
-    for (unsigned t = 1; t < threads; ++t) threads_.emplace_back([this, t] { loop(t); });
-    size_ = threads;
-  }
-  ~WorkerPool() {
-    {
-      std::lock_guard<std::mutex> lock(m_);
-      stop_ = true;
-    }
-    cv_.notify_all();
-    for (auto& t : threads_) t.join();
-  }
-  unsigned size() const { return size_; }
-  // fn(t) for t in [0, size): slot 0 on the calling thread
-  void run(const std::function<void(unsigned)>& fn) {
-    {
-      std::lock_guard<std::mutex> lock(m_);
-      fn_ = &fn;
-      pending_ = size_ - 1;
-      ++generation_;
-    }
-    cv_.notify_all();
-    std::exception_ptr first;
-    try {
-      fn(0);
-    } catch (...) {
-      first = std::current_exception();
-    }
-    std::unique_lock<std::mutex> lock(m_);
-    done_.wait(lock, [this] { return pending_ == 0; });
-    if (!first) first = error_;
-    error_ = nullptr;
-    if (first) std::rethrow_exception(first);
-  }
-
- private:
-  void loop(unsigned t) {
-    std::uint64_t seen = 0;
-    for (;;) {
-      const std::function<void(unsigned)>* fn = nullptr;
-      {
-        std::unique_lock<std::mutex> lock(m_);
-        cv_.wait(lock, [&] { return stop_ || generation_ != seen; });
-        if (stop_) return;
-        seen = generation_;
-        fn = fn_;
-      }
-      std::exception_ptr err;
-      try {
-        (*fn)(t);
-      } catch (...) {
-        err = std::current_exception();
-      }
-      std::lock_guard<std::mutex> lock(m_);
-      if (err && !error_) error_ = err;
-      if (--pending_ == 0) done_.notify_all();
-    }
-  }
-  std::vector<std::thread> threads_;
-  unsigned size_{1};
-  std::mutex m_;
-  std::condition_variable cv_, done_;
-  const std::function<void(unsigned)>* fn_{nullptr};
-  unsigned pending_{0};
-  std::uint64_t generation_{0};
-  bool stop_{false};
-  std::exception_ptr error_;
 };
 
 // num_envs environments stepped together on worker threads (the GIL is released while they step).

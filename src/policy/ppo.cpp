@@ -222,6 +222,11 @@ Eigen::VectorXf PpoLearner::log_prob(const Eigen::MatrixXf& mean, const Eigen::M
 }
 
 PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_seed, unsigned threads) {
+  WorkerPool pool(std::min<unsigned>(resolve_threads(threads), kGradChunks));
+  return update(batch, shuffle_seed, pool);
+}
+
+PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_seed, WorkerPool& pool) {
   const Eigen::Index n = batch.size();
   const Eigen::Index mb = n / std::max(1, o_.num_minibatches);
   if (mb < 1) throw std::invalid_argument("PPO update: fewer transitions than minibatches");
@@ -253,7 +258,7 @@ PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_s
       const Eigen::VectorXf nadv = (adv.array() - am) / (as + 1e-8f);
       const float inv_m = 1.0f / static_cast<float>(mb);
       std::atomic<int> next{0};
-      WorkerPool pool(std::min<unsigned>(resolve_threads(threads), kGradChunks), [&](unsigned) {
+      pool.run([&](unsigned) {
         while (true) {
           const int ci = next.fetch_add(1);
           if (ci >= kGradChunks) break;
@@ -289,7 +294,6 @@ PpoUpdateStats PpoLearner::update(const PpoBatch& batch, std::uint64_t shuffle_s
           backward(critic_, cact, Eigen::MatrixXf(static_cast<float>(o_.vf_coef) * inv_m * dv), g.critic);
         }
       });
-      pool.join();
       ChunkGrad& total = chunks[0];
       for (int ci = 1; ci < kGradChunks; ++ci) {
         const ChunkGrad& g = chunks[static_cast<std::size_t>(ci)];
@@ -378,6 +382,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(o.threads);
+  WorkerPool pool(threads);  // one pool for the whole run: environment steps and gradient chunks
   auto model = sim::EnvModel::make(o.task, sim::profile_config(o.profile));
   const int env_obs_dim = model->layout().size();
   const int hist_dim = o.delay_aware ? kHistoryLength * kActionDim : 0;
@@ -452,7 +457,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       batch.log_probs.segment(base, n_env) = lp;
       values.segment(base, n_env) = val;
       std::atomic<int> next{0};
-      WorkerPool pool(threads, [&](unsigned) {
+      pool.run([&](unsigned) {
         while (true) {
           const int e = next.fetch_add(1);
           if (e >= n_env) break;
@@ -482,7 +487,6 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
           }
         }
       });
-      pool.join();
       bool any_boot = false;
       for (int e = 0; e < n_env; ++e) {
         const auto ue = static_cast<std::size_t>(e);
@@ -509,7 +513,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       learner.set_learning_rate(o.learning_rate * (1.0 - static_cast<double>(it) / static_cast<double>(iterations)));
     batch.advantages = gae(rewards, values, final_values, ended, learner.value(cur), n_env, o.gamma, o.gae_lambda);
     batch.returns = batch.advantages + values;
-    const PpoUpdateStats us = learner.update(batch, derive_seed({o.seed, kPpoStream, 4, static_cast<std::uint64_t>(it)}), threads);
+    const PpoUpdateStats us = learner.update(batch, derive_seed({o.seed, kPpoStream, 4, static_cast<std::uint64_t>(it)}), pool);
     rec.env_steps = env_steps;
     rec.mean_return = rec.episodes > 0 ? return_sum / rec.episodes : std::numeric_limits<double>::quiet_NaN();
     rec.policy_loss = us.policy_loss;

@@ -1,11 +1,15 @@
-// The project's one worker pool (core/workers.hpp): every worker index runs once, work pulled from a
-// shared counter lands in per-item slots whatever the worker count, and a worker's exception reaches
-// join().
+// The project's one worker pool (core/workers.hpp): every worker index runs once per round, work pulled
+// from a shared counter lands in per-item slots whatever the worker count, a worker's exception reaches
+// join(), and a pool runs many rounds on the same threads.
 #include "actionshift/core/workers.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <mutex>
+#include <set>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
@@ -50,6 +54,42 @@ TEST(WorkerPool, TheFirstExceptionReachesJoinAfterEveryWorkerFinished) {
       },
       std::runtime_error);
   EXPECT_EQ(finished.load(), 4);
+}
+
+TEST(WorkerPool, RoundsRunOnTheSameThreadsAndEachRoundsErrorIsItsOwn) {
+  WorkerPool pool(3);
+  EXPECT_EQ(pool.size(), 3u);
+  std::mutex mu;
+  std::set<std::thread::id> ids;
+  std::vector<int> counts(3, 0);
+  for (int round = 0; round < 200; ++round)
+    pool.run([&](unsigned w) {
+      std::lock_guard<std::mutex> lock(mu);
+      ids.insert(std::this_thread::get_id());
+      ++counts[w];
+    });
+  EXPECT_EQ(ids.size(), 3u);  // no thread started per round
+  EXPECT_EQ(counts, std::vector<int>({200, 200, 200}));
+  EXPECT_EQ(ids.count(std::this_thread::get_id()), 0u);
+  // a failing round throws from its join; the next round starts clean
+  EXPECT_THROW(pool.run([](unsigned w) {
+    if (w == 1) throw std::runtime_error("round failed");
+  }), std::runtime_error);
+  std::atomic<int> ran{0};
+  EXPECT_NO_THROW(pool.run([&](unsigned) { ++ran; }));
+  EXPECT_EQ(ran.load(), 3);
+  // start() returns at once; a second start() waits for the first round; the destructor waits too
+  std::atomic<int> slow{0};
+  {
+    WorkerPool p(2);
+    p.start([&](unsigned) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      ++slow;
+    });
+    p.start([&](unsigned) { ++slow; });
+    EXPECT_GE(slow.load(), 2);
+  }
+  EXPECT_EQ(slow.load(), 4);
 }
 
 }  // namespace

@@ -1,14 +1,18 @@
 #pragma once
 /// \file The project's one worker pool: every parallel loop (the evaluation runner, policy rollouts,
-/// DAgger data collection, the environment bench) runs its workers through WorkerPool, so thread
-/// counts, joining and error propagation behave the same everywhere.
+/// DAgger data collection, PPO, the Python module's VecEnv, the environment bench) runs its workers
+/// through WorkerPool, so thread counts, joining and error propagation behave the same everywhere.
 ///
-/// A pool starts `size` threads that each run `body(worker_index)` once (a body typically pulls work
-/// items from a shared atomic counter); join() waits for all of them and rethrows the first
-/// exception a body let escape. Results must not depend on the number of workers: callers write
-/// per-item results into slots indexed by the item, never by the worker.
+/// A pool keeps `size` threads for its lifetime; each round (start/join, or run) has every worker run
+/// `body(worker_index)` once (a body typically pulls work items from a shared atomic counter), and
+/// join() waits for all of them and rethrows the first exception a body let escape. A loop that runs
+/// many rounds (PPO's environment steps and gradient chunks, the Python VecEnv's steps) keeps one pool
+/// instead of starting threads per round. Results must not depend on the number of workers: callers
+/// write per-item results into slots indexed by the item, never by the worker.
 
 #include <algorithm>
+#include <condition_variable>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <mutex>
@@ -25,41 +29,89 @@ inline unsigned resolve_threads(unsigned requested) {
 
 class WorkerPool {
  public:
-  /// Starts max(1, threads) workers running body(0) … body(threads − 1).
-  WorkerPool(unsigned threads, std::function<void(unsigned)> body) : body_(std::move(body)) {
+  /// Starts max(1, threads) worker threads, idle until start() or run() gives them a round.
+  explicit WorkerPool(unsigned threads) {
     const unsigned n = std::max(1u, threads);
     threads_.reserve(n);
-    for (unsigned w = 0; w < n; ++w)
-      threads_.emplace_back([this, w] {
-        try {
-          body_(w);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(mu_);
-          if (!error_) error_ = std::current_exception();
-        }
-      });
+    for (unsigned w = 0; w < n; ++w) threads_.emplace_back([this, w] { loop(w); });
   }
+  /// Starts max(1, threads) workers and a first round running body(0) … body(threads − 1).
+  WorkerPool(unsigned threads, std::function<void(unsigned)> body) : WorkerPool(threads) { start(std::move(body)); }
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
-  /// Joins (never throws; call join() to see a worker's exception).
+  /// Waits for a running round and stops the threads (never throws; call join() to see a worker's exception).
   ~WorkerPool() {
-    for (auto& t : threads_)
-      if (t.joinable()) t.join();
+    {
+      std::unique_lock<std::mutex> lock(mu_);
+      idle_.wait(lock, [this] { return pending_ == 0; });
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (auto& t : threads_) t.join();
   }
 
   unsigned size() const noexcept { return static_cast<unsigned>(threads_.size()); }
 
-  /// Waits for every worker; rethrows the first exception one of them threw.
+  /// Starts a round: every worker w runs body(w) once; returns at once (one round at a time: a second
+  /// start() first waits for the running round to finish).
+  void start(std::function<void(unsigned)> body) {
+    {
+      std::unique_lock<std::mutex> lock(mu_);
+      idle_.wait(lock, [this] { return pending_ == 0; });
+      body_ = std::move(body);
+      pending_ = size();
+      error_ = nullptr;
+      ++generation_;
+    }
+    wake_.notify_all();
+  }
+
+  /// Waits for the round to finish; rethrows the first exception one of its bodies threw.
   void join() {
-    for (auto& t : threads_)
-      if (t.joinable()) t.join();
-    if (error_) std::rethrow_exception(error_);
+    std::unique_lock<std::mutex> lock(mu_);
+    idle_.wait(lock, [this] { return pending_ == 0; });
+    if (error_) {
+      std::exception_ptr e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+
+  /// start(body) then join(): the persistent pool's parallel loop (no thread is started per call).
+  void run(std::function<void(unsigned)> body) {
+    start(std::move(body));
+    join();
   }
 
  private:
-  std::function<void(unsigned)> body_;
+  void loop(unsigned w) {
+    std::uint64_t seen = 0;
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(mu_);
+        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+      }
+      std::exception_ptr err;
+      try {
+        body_(w);  // body_ is not reassigned before every worker of this round has finished
+      } catch (...) {
+        err = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(mu_);
+      if (err && !error_) error_ = err;
+      if (--pending_ == 0) idle_.notify_all();
+    }
+  }
+
   std::vector<std::thread> threads_;
+  std::function<void(unsigned)> body_;
   std::mutex mu_;
+  std::condition_variable wake_, idle_;
+  unsigned pending_{0};
+  std::uint64_t generation_{0};
+  bool stop_{false};
   std::exception_ptr error_;
 };
 

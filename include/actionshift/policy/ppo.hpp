@@ -22,6 +22,7 @@
 /// are stored by environment index; a minibatch gradient is the ordered sum of a fixed number of
 /// chunk gradients, computed in parallel.
 
+#include "actionshift/core/workers.hpp"
 #include "actionshift/policy/mlp.hpp"
 #include "actionshift/sim/env.hpp"
 
@@ -160,6 +161,9 @@ class PpoLearner {
   /// The clipped-objective update on a batch: update_epochs epochs of shuffled minibatches (shuffle
   /// from `shuffle_seed`), gradient computed by `threads` workers over a fixed chunking.
   PpoUpdateStats update(const PpoBatch& batch, std::uint64_t shuffle_seed, unsigned threads);
+  /// The same on a pool the caller keeps (train_ppo's, shared with its environment steps): the same
+  /// result whatever the pool's size.
+  PpoUpdateStats update(const PpoBatch& batch, std::uint64_t shuffle_seed, WorkerPool& pool);
   /// Set the Adam learning rate of the following updates (learning-rate annealing).
   void set_learning_rate(double lr) { o_.learning_rate = lr; }
   /// Freeze the actor and log std in the following updates (only the critic learns).
