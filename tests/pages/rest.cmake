@@ -1,10 +1,10 @@
-# Golden tests of the long-lag, brittleness, noise-sensitivity, Gate 0, identifiers, DualABI-pilot and ladder
-# pages (included by tests/pages/CMakeLists.txt): each runs `actionshift compare` on a committed fixture and the
+# Golden tests of the long-lag, brittleness, noise-sensitivity, Gate 0, identifiers, DualABI-pilot, ladder,
+# backbone-variance and audit pages (included by tests/pages/CMakeLists.txt): each runs `actionshift compare` on a committed fixture and the
 # page script, and compares with tests/pages/golden/<page>.md (the ladder: one compare per group of
 # scripts/ladder_groups.py, pairs from the fixture's ladder*.pairs).
 find_package(Python3 COMPONENTS Interpreter)
 if(Python3_Interpreter_FOUND)
-  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance)
+  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance audit)
     add_test(NAME pages.${page}
              COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/run_page_test.py ${page} $<TARGET_FILE:actionshift>)
     set_tests_properties(pages.${page} PROPERTIES LABELS pages TIMEOUT 120)

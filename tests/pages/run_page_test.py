@@ -75,6 +75,20 @@ def page_text(page, binary, tmp):
         compare(binary, [f"{b}/results"], f"{tmp}/learned.json", "scripts/backbone_variance.pairs", ["--across-backbones"])
         return py("scripts/ladder_report.py", f"{d}/results", cdir, *PROV, "--command", f"scripts/ladder {d}/results",
                   "--learned", f"{tmp}/learned.json", "--learned-command", f"scripts/backbone_variance {b}/results")
+    if page == "audit":
+        # real audit outputs (tests/pages/data/audit/: a few of the benchmark's, and one wrong verdict of the
+        # audit's first model so the wrong-verdicts table is laid out); the intervals need the build's module
+        build = os.path.dirname(os.path.dirname(os.path.dirname(binary)))
+        env = dict(os.environ, PYTHONPATH=os.path.join(build, "python"))
+        chosen = subprocess.run([sys.executable, "scripts/audit_report.py", "--choose", f"{d}/pilot"], check=True, cwd=ROOT,
+                                capture_output=True, text=True, env=env).stdout.split()
+        out = f"{tmp}/audit.md"
+        subprocess.run([sys.executable, "scripts/audit_report.py", "--out", out, "--svg", f"{tmp}/audit.svg", "--pilot", f"{d}/pilot",
+                        "--evaluation", f"{d}/evaluation", "--floor", chosen[0], "--tolerance", chosen[1], "--tolerances", "1.8 2.2",
+                        "--command", f"scripts/audit_benchmark {d}", "--commit", "0000000", "--wall", "12",
+                        "--pilot-seeds", "20260801", "--eval-seeds", "20260811 20260812", "--lengths", "50 200 5000",
+                        "--noises", "0 0.005", "--floors", "0.99"], check=True, cwd=ROOT, env=env, capture_output=True)
+        return open(out).read() + "\n<!-- svg -->\n" + open(f"{tmp}/audit.svg").read()
     raise SystemExit(f"run_page_test: unknown page {page}")
 
 
