@@ -78,10 +78,11 @@ def main():
     w("- Verdicts: **holds on every backbone** (the pooled interval and each backbone's exclude 0 with one sign), "
       "**holds on average** (the pooled one does, some backbone's does not), **depends on the backbone** (backbones "
       "significant with opposite signs, or shown on some backbones while the pooled interval includes 0), **not shown**.")
-    w("- Not here: pick_cube (its two-stage recipe's replicas have a committed adoption rule and script, "
-      "`scripts/backbone_replicas_pick`, but are not trained yet: docs/backbones.md) and stack_cube (its recipe starts from a "
-      "weak imitation network and is not replicated), and so the learned identifiers (trained for pick_cube only). The "
-      "probing methods on the delay-aware backbones under lag are on docs/results/long_lag.md.")
+    missing = [t for t in ("pick_cube", "push_cube", "pull_cube") if t not in tasks]
+    w("- Not here: " + (", ".join(missing) + " (not among the results compared) and " if missing else "") + "stack_cube (its recipe starts from a weak imitation network and is not "
+      "replicated). The learned identifiers (`osi`, `probe_osi`, `recurrent_osi`) are trained for pick_cube only, so "
+      "their rows and pairs are pick_cube's. The probing methods on the delay-aware backbones under lag are on "
+      "docs/results/long_lag.md.")
     w("")
     w("## The backbones (Gate 0, 300 episodes)")
     w("")

@@ -6,7 +6,7 @@ import os
 from . import fmt
 
 # the ladder's order (the paper's Fig. 4, bottom to top)
-RUNGS = ["no_adapt", "grammar_belief", "fixed_probes", "random_probes", "entropy_probes", "exact_belief", "dualabi", "oracle"]
+RUNGS = ["no_adapt", "osi", "probe_osi", "recurrent_osi", "grammar_belief", "fixed_probes", "random_probes", "entropy_probes", "exact_belief", "dualabi", "oracle"]
 
 
 def training_seed(backbone):
@@ -26,7 +26,8 @@ def rung_key(label):
 # the paper's findings (its methods, its probe rule) among the across-backbones pairs (scripts/backbone_variance.pairs)
 PAPER_PAIRS = ["oracle vs no_adapt", "entropy_probes vs no_adapt", "entropy_probes vs fixed_probes",
                "dualabi vs entropy_probes", "oracle vs entropy_probes", "grammar_belief{probe=hold} vs no_adapt",
-               "entropy_probes vs grammar_belief{probe=hold}", "grammar_belief{probe=hold} vs grammar_belief"]
+               "entropy_probes vs grammar_belief{probe=hold}", "grammar_belief{probe=hold} vs grammar_belief",
+               "osi vs no_adapt", "grammar_belief vs osi"]
 VERDICT_TEXT = {"holds_on_every_backbone": "holds on every backbone", "holds_on_average": "holds on average",
                 "depends_on_backbone": "depends on the backbone", "not_shown": "not shown"}
 

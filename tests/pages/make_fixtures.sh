@@ -34,6 +34,13 @@ for page in $PAGES; do
           N=2 SEED=$seed run --task push_cube --split reference_seen --method "$m" --pool reference9 --backbone "$b" --out "$D/$page/results"
         done
       done
+    done
+    # and of pick_cube, with its learned identifiers (the pairs that only pick_cube has)
+    for b in ppo mlp:configs/backbones/replicas/pick_cube.ppo.seed20260801.asmlp mlp:configs/backbones/replicas/pick_cube.ppo.seed20260802.asmlp; do
+      for seed in 20260718 20260719; do
+        for m in oracle no_adapt osi probe_osi recurrent_osi; do N=2 SEED=$seed run --task pick_cube --split reference_seen --method "$m" --backbone "$b" --out "$D/$page/results"; done
+        N=2 SEED=$seed run --task pick_cube --split reference_seen --method grammar_belief --params '{"probe":"none"}' --backbone "$b" --out "$D/$page/results"
+      done
     done ;;
   long_lag)
     for b in expert expert-delay-aware; do
