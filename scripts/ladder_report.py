@@ -248,7 +248,7 @@ def main():
         "scripts/ladder_report.py", a.command or f"scripts/ladder {res}", commit_of(a), [res],
         provenance.spec_values(specs, "profile"), live.seeds(layout), sum(c["episodes"] for c in layout), jobs=len(jobs),
         episodes_per_seed=live.episodes_per_seed(layout), wall=a.wall, cores=a.cores, paper_source=live.paper_source(),
-        bootstrap=live.data["bootstrap"],
+        bootstrap=live.data["bootstrap"], reused=a.reused,
         extra=[f"CPU: {cpu_text(a.cpu)[2:] or 'not measured'}.",
                "Compare runs (scripts/ladder_groups.py; one JSON per group, merged here only for layout, because "
                "directories that differ by the pool or the frame rotation share method labels): " + group_text + ".",

@@ -23,6 +23,7 @@ ap.add_argument("--commit", required=True)
 ap.add_argument("--command", required=True)
 ap.add_argument("--wall")
 ap.add_argument("--cores")
+ap.add_argument("--reused", type=int, default=0, help="jobs the command found complete (run by an earlier invocation)")
 ap.add_argument("--displacement", help="optional JSON {summary, rows} on the cause of the probe displacement")
 ap.add_argument("--numbers", default=paper.NUMBERS)
 ap.add_argument("--across", help="compare --across-backbones JSON of scripts/backbone_variance (optional)")
@@ -36,7 +37,7 @@ out = [provenance.header(
     "Tournament: the pool-belief ladder on the cube tasks", "scripts/tournament_report.py", a.command, a.commit,
     c.input_dirs(), provenance.spec_values(specs, "profile"), c.seeds(), c.episodes(), jobs=len(c.jobs()),
     episodes_per_seed=c.episodes_per_seed(), wall=a.wall, cores=a.cores, paper_source=c.paper_source(),
-    bootstrap=c.bootstrap(),
+    bootstrap=c.bootstrap(), reused=a.reused,
     extra=["Experiments `configs/experiments/tournament.yaml` (expert)"
            + (" and `configs/experiments/tournament_ppo.yaml` (PPO)" if "ppo" in backbones else "")
            + "; backbones " + ", ".join(f"`{b}`" for b in backbones) + "; pools "

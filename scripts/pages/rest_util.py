@@ -20,6 +20,8 @@ def parser(doc):
     p.add_argument("--wall", help="wall time of the runs in s (empty: not measured)")
     p.add_argument("--cores", help="cores of the machine the runs used")
     p.add_argument("--cpu", default="", help="the `times` line of the runs (user and system time of the children)")
+    p.add_argument("--reused", type=int, default=0,
+                   help="jobs the command found already complete (run by an earlier invocation); the wall time omits them")
     return p
 
 

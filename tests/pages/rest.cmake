@@ -22,3 +22,8 @@ if(Python3_Interpreter_FOUND)
            COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/long_lag_verdict_test.py)
   set_tests_properties(pages.long_lag_verdict PROPERTIES LABELS pages TIMEOUT 60)
 endif()
+if(Python3_Interpreter_FOUND)
+  # the wall-time clause of every page header: jobs an earlier invocation ran are named, not counted as this run's time
+  add_test(NAME pages.wall_text COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/wall_text_test.py)
+  set_tests_properties(pages.wall_text PROPERTIES LABELS pages TIMEOUT 60)
+endif()
