@@ -129,6 +129,11 @@ void register_policy_commands(CLI::App& app, CliContext& ctx) {
   gate0->add_option("--seed", gate0_o.run.seed, "Experimental seed")->check(kSeed)->capture_default_str();
   gate0->add_option("--floor", gate0_o.run.floor, "Competence floor (default: 0.5, peg_insertion_side 0.2)")
       ->check(CLI::Range(0.0, 1.0) & kNotNan);
+  gate0->add_option("--horizon", gate0_o.run.horizon,
+                    "Control steps per episode (default 0: the task's, 50; peg_insertion_side 100). The reference\n"
+                    "evaluates its Diffusion Policy at 100 on every task; the verdict records a horizon given here")
+      ->check(CLI::Range(0, policy::kMaxGate0Horizon))
+      ->capture_default_str();
   gate0->add_option("--rule", gate0_o.rule, "Competence statistic: wilson_lower or point_estimate")->capture_default_str();
   gate0->add_option("--threads", gate0_o.run.threads, "Worker threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
   gate0->add_flag("--json", gate0_o.json, "Print the verdict file instead of text");

@@ -394,7 +394,7 @@ int run_gate0(Gate0Options o, std::ostream& out, std::ostream& err) {
     const auto& c = v.competence;
     const auto& p = v.identity_parity;
     out << "Gate 0: " << v.backbone << " on " << v.task << " (" << v.episodes << " episodes, seed " << v.seed
-        << (v.robot_sha256.empty() ? "" : ", robot " + v.robot_sha256.substr(0, 12)) << ")\n"
+        << (v.horizon > 0 ? ", horizon " + std::to_string(v.horizon) : "") << (v.robot_sha256.empty() ? "" : ", robot " + v.robot_sha256.substr(0, 12)) << ")\n"
         << "  competence: success_once " << c.interval.successes << "/" << c.interval.total << " = " << fmt(c.interval.rate)
         << " [" << fmt(c.interval.lower) << ", " << fmt(c.interval.upper) << "], floor " << fmt(c.floor, 2) << " ("
         << policy::gate0_rule_name(c.rule) << "): " << (c.passed ? "pass" : "fail") << "\n"

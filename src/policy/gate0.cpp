@@ -102,13 +102,18 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
 
 void check_gate0_run(const Gate0Run& run) {
   if (run.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
+  if (run.horizon < 0 || run.horizon > kMaxGate0Horizon)
+    throw InputError("", "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxGate0Horizon) + " control steps, got " +
+                                        std::to_string(run.horizon));
 }
 
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   check_gate0_run(run);
   if (run.robot && run.robot_sha256.empty())
     throw InputError("gate0", "robot_sha256", "a robot description needs its content hash (sim::load_robot_source), which the verdict records");
-  auto model = sim::EnvModel::make(policy.task(), sim::profile_config(run.profile), run.robot);
+  sim::EnvConfig config = sim::profile_config(run.profile);
+  config.horizon = run.horizon;
+  auto model = sim::EnvModel::make(policy.task(), config, run.robot);
   RolloutOptions o;
   o.seed = run.seed;
   o.contract_index = 0;
@@ -123,6 +128,7 @@ Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {
   Gate0Verdict v = gate0_verdict(policy.name(), policy.sha256(), policy.task(), unwrapped, identity, floor, run.rule);
   v.seed = run.seed;
   v.profile = run.profile;
+  v.horizon = run.horizon;
   v.robot_sha256 = run.robot ? run.robot_sha256 : std::string();
   return v;
 }
@@ -161,6 +167,7 @@ nlohmann::json gate0_to_json(const std::vector<Gate0Verdict>& verdicts) {
         {"success_at_end", v.success_at_end_unwrapped},
         {"safety_flagged", {{"unwrapped", v.flagged_unwrapped}, {"identity", v.flagged_identity}}}};
     if (!v.robot_sha256.empty()) cell["robot"] = {{"sha256", v.robot_sha256}};
+    if (v.horizon > 0) cell["horizon"] = v.horizon;  // only an override, so verdicts at the task's horizon keep their bytes
   }
   j["passed"] = all;
   return j;

@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <fstream>
 
 using namespace actionshift;
@@ -62,6 +63,37 @@ TEST(Gate0, ExcludesAPolicyThatDoesNothing) {
   EXPECT_EQ(v.decision, "exclude");
   EXPECT_THAT(v.reason, HasSubstr("competence: success Wilson lower bound 0.0000 below floor 0.5000"));
   EXPECT_TRUE(v.identity_parity.passed);
+}
+
+TEST(Gate0, AHorizonOverrideSetsTheEpisodeLengthAndIsRecordedOnlyWhenGiven) {
+  // an idle policy that counts its steps, shared by every clone: each episode runs the full horizon
+  struct Counting final : policy::Policy {
+    std::shared_ptr<std::atomic<int>> steps = std::make_shared<std::atomic<int>>(0);
+    void reset() override {}
+    Action act(const Eigen::Ref<const Eigen::VectorXd>&) override {
+      ++*steps;
+      return Action::Zero();
+    }
+    std::string name() const override { return "counting"; }
+    std::string sha256() const override { return std::string(64, '0'); }
+    sim::TaskId task() const override { return sim::TaskId::kPushCube; }
+    std::unique_ptr<policy::Policy> clone() const override { return std::make_unique<Counting>(*this); }
+  } counting;
+  policy::Gate0Run run;
+  run.episodes = 2;
+  run.threads = 1;
+  const auto task_default = policy::run_gate0(counting, run);
+  EXPECT_EQ(counting.steps->load(), 2 * 2 * 50);  // unwrapped and identity-wrapped, push_cube's 50 steps
+  EXPECT_FALSE(policy::gate0_to_json({task_default}).at("cells").at("counting/push_cube").contains("horizon"));
+  *counting.steps = 0;
+  run.horizon = 7;
+  const auto seven = policy::run_gate0(counting, run);
+  EXPECT_EQ(counting.steps->load(), 2 * 2 * 7);
+  EXPECT_EQ(policy::gate0_to_json({seven}).at("cells").at("counting/push_cube").at("horizon"), 7);
+  run.horizon = -1;
+  EXPECT_THAT([&] { policy::check_gate0_run(run); }, ::testing::ThrowsMessage<InputError>(HasSubstr("horizon")));
+  run.horizon = policy::kMaxGate0Horizon + 1;
+  EXPECT_THAT([&] { policy::run_gate0(counting, run); }, ::testing::ThrowsMessage<InputError>(HasSubstr("horizon")));
 }
 
 TEST(Gate0, AVerdictOnAUserRobotNamesItsHashInTheCellKeyAndCell) {

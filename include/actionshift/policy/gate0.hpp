@@ -67,12 +67,18 @@ Gate0Competence gate0_competence(std::int64_t successes, std::int64_t total, dou
 Gate0Parity gate0_parity(std::int64_t ref_successes, std::int64_t ref_total, std::int64_t wrap_successes,
                          std::int64_t wrap_total, double tolerance = kGate0ParityTolerance);
 
+/// Largest horizon a Gate 0 run accepts (control steps).
+inline constexpr int kMaxGate0Horizon = 10000;
+
 /// Settings of a Gate 0 run.
 struct Gate0Run {
   std::string profile{"maniskill"};  ///< simulator fidelity profile (sim::profile_config)
   std::int64_t episodes{300};
   std::uint64_t seed{20260718};
   double floor{-1.0};  ///< < 0: gate0_floor(task)
+  /// Control steps per episode; 0: the task's (50, peg_insertion_side 100). The reference evaluates its
+  /// Diffusion Policy at 100 on every task. A verdict records it only when it is not the task's.
+  int horizon{0};
   Gate0Rule rule{Gate0Rule::kWilsonLower};
   unsigned threads{0};
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (finished, total) over both runs
@@ -83,7 +89,7 @@ struct Gate0Run {
 };
 
 /// The checks run_gate0 makes before any episode (the CLI makes them before it builds the backbone):
-/// at least one episode. Throws actionshift::InputError.
+/// at least one episode, a horizon in [0, kMaxGate0Horizon]. Throws actionshift::InputError.
 void check_gate0_run(const Gate0Run& run);
 
 /// A Gate 0 verdict for one backbone and task.
@@ -93,6 +99,7 @@ struct Gate0Verdict {
   std::string robot_sha256;          ///< content hash of a user-supplied robot description; "" for the embedded Panda
   std::uint64_t seed{0};
   std::int64_t episodes{0};
+  int horizon{0};  ///< the run's horizon override; 0: the task's
   Gate0Competence competence;
   Gate0Parity identity_parity;
   std::int64_t success_at_end_unwrapped{0};
