@@ -51,6 +51,11 @@ void add_job_options(CliContext& ctx, CLI::App* cmd, CliJobOptions& j, bool requ
                   "metres per position coordinate and radians per rotation-vector component (0..0.1), drawn per\n"
                   "episode; seen by policy and adapter alike; part of the job id when non-zero (docs/sim.md 6.1)")
       ->capture_default_str();
+  cmd->add_option("--horizon", j.request.horizon,
+                  "Control steps per episode (0: the task's, 50; peg_insertion_side 100); part of the job id when\n"
+                  "not 0 (the reference evaluates its Diffusion Policy at 100)")
+      ->check(CLI::Range(0, eval::kMaxJobHorizon))
+      ->capture_default_str();
   cmd->add_option("--calibration", j.calibration,
                   "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"
                   "`calibrate --obs-noise S --out FILE`); its hash is the job's calibration_sha256");

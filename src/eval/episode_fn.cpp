@@ -46,10 +46,11 @@ Manifest job_manifest(const std::string& name, const std::string& path, bool poo
 
 namespace {
 
-// the job's environment settings: its fidelity profile plus its observation noise (0: off)
+// the job's environment settings: its fidelity profile plus its observation noise (0: off) and horizon (0: the task's)
 sim::EnvConfig env_config(const JobSpec& job) {
   sim::EnvConfig c = sim::profile_config(job.profile);
   c.obs_noise = job.obs_noise;
+  c.horizon = job.horizon;
   return c;
 }
 

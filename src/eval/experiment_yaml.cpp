@@ -228,14 +228,15 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   if (!docs.empty()) root = docs.front();
   if (!root.IsMap()) throw InputError(source, "", "expected a mapping of experiment keys at the top level");
   static const std::set<std::string> known = {"name",     "description", "tasks",    "splits", "methods",
-                                               "seeds",    "episodes",    "backbone", "pool",   "rotation_mode", "profile"};
+                                               "seeds",    "episodes",    "backbone", "pool",   "rotation_mode", "profile",
+                                               "horizon"};
   std::set<std::string> seen_keys;  // yaml-cpp keeps both entries of a repeated key and reads the first
   for (const auto& kv : root) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
     if (!known.count(key))
       throw InputError(at_line(source, kv.first), key,
                        "unknown key (expected one of name, description, tasks, splits, methods, seeds, episodes, "
-                       "backbone, pool, rotation_mode, profile)");
+                       "backbone, pool, rotation_mode, profile, horizon)");
     if (!seen_keys.insert(key).second) throw InputError(at_line(source, kv.first), key, "duplicate key");
   }
   for (const char* key : {"name", "tasks", "splits", "methods", "seeds", "episodes", "backbone"})
@@ -333,6 +334,14 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   if (root["profile"]) {
     ex.profile = require_string(root["profile"], source, "profile");
     (void)parse_profile(ex.profile, at_line(source, root["profile"]), "profile");
+  }
+  if (root["horizon"]) {
+    const auto h = as_int(root["horizon"]);
+    if (!h || *h < 0 || *h > kMaxJobHorizon)
+      throw InputError(at_line(source, root["horizon"]), "horizon",
+                       "expected control steps per episode, 0 (the task's) to " + std::to_string(kMaxJobHorizon) + " (got " +
+                           yaml_text(root["horizon"]) + ")");
+    ex.horizon = static_cast<int>(*h);
   }
   return ex;
 }

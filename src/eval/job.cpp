@@ -110,6 +110,9 @@ void validate_job(const JobSpec& job, const std::string& src) {
     got << job.obs_noise;
     throw InputError(src, "obs_noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
   }
+  if (job.horizon < 0 || job.horizon > kMaxJobHorizon)
+    throw InputError(src, "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxJobHorizon) + " control steps (got " +
+                                         std::to_string(job.horizon) + ")");
   if (job.policy_files) {
     check_hash(job.policy_files->sha256, src, "policy_files.sha256");
     if (job.policy_files->paths.empty()) throw InputError(src, "policy_files.paths", "must name at least one file");
@@ -149,6 +152,7 @@ nlohmann::json job_to_json(const JobSpec& job) {
   }
   if (job.policy_files) j["policy_files"] = {{"sha256", job.policy_files->sha256}, {"paths", job.policy_files->paths}};
   if (job.obs_noise != 0.0) j["obs_noise"] = job.obs_noise;
+  if (job.horizon != 0) j["horizon"] = job.horizon;
   return j;
 }
 
@@ -168,6 +172,20 @@ std::string job_canonical_json(const JobSpec& job) { return canonical_dump(job_i
 std::string job_id(const JobSpec& job) { return sha256_hex(job_canonical_json(job)); }
 
 JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
+  if (j.is_object() && j.contains("horizon")) {  // optional: present only for a horizon other than the task's
+    json rest = j;
+    rest.erase("horizon");
+    JobSpec job = job_from_json(rest, src);
+    const json& v = j.at("horizon");
+    if (!v.is_number_integer()) throw InputError(src, "horizon", "expected an integer number of control steps");
+    const auto h = v.get<std::int64_t>();
+    if (h < 0 || h > kMaxJobHorizon)
+      throw InputError(src, "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxJobHorizon) + " control steps (got " +
+                                           std::to_string(h) + ")");
+    job.horizon = static_cast<int>(h);
+    validate_job(job, src);
+    return job;
+  }
   if (j.is_object() && j.contains("obs_noise")) {  // optional: present only for a noisy environment
     json rest = j;
     rest.erase("obs_noise");

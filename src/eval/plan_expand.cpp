@@ -33,6 +33,7 @@ JobSpec resolve_job(const JobRequest& q, const PlanResolver& resolver) {
   job.seed = q.seed;
   job.episodes = q.episodes;
   job.obs_noise = q.obs_noise;
+  job.horizon = q.horizon;
   validate_job(job, q.source);
   return job;
 }
@@ -117,6 +118,7 @@ Plan make_plan(const Experiment& ex, const PlanResolver& resolver) {
           pj.spec.calibration_sha256 = calibration;
           pj.spec.rotation_mode = ex.rotation_mode;
           pj.spec.profile = ex.profile;
+          pj.spec.horizon = ex.horizon;
           pj.spec.seed = seed;
           pj.spec.episodes = ex.episodes;
           in_experiment(ex, task_field, [&] { validate_job(pj.spec, ex.source); });

@@ -160,6 +160,34 @@ TEST(JobSpec, ObsNoiseEntersTheSpecAndTheIdOnlyWhenNonZero) {
   EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: obs_noise: must be")));
 }
 
+TEST(JobSpec, HorizonEntersTheSpecAndTheIdOnlyWhenNonZero) {
+  JobSpec j = golden_job();
+  j.horizon = 0;  // the task's: the spec, its canonical text and its id are those of every earlier job
+  EXPECT_FALSE(job_to_json(j).contains("horizon"));
+  EXPECT_EQ(job_id(j), "e59abadf5e6c68cb630ee3b2bea3904e04e12f82e58413eec1e20b5274f7006e");
+  j.horizon = 100;
+  EXPECT_THAT(job_canonical_json(j), HasSubstr("\"horizon\":100,"));
+  EXPECT_NE(job_id(j), job_id(golden_job()));
+  const JobSpec back = job_from_json(job_to_json(j), "plan.json");
+  EXPECT_EQ(back, j);
+  EXPECT_EQ(job_id(back), job_id(j));
+  for (int bad : {-1, kMaxJobHorizon + 1}) {
+    JobSpec b = golden_job();
+    b.horizon = bad;
+    EXPECT_THAT([&] { validate_job(b, "cli"); }, ThrowsMessage<InputError>(HasSubstr("cli: horizon: must be 0 (the task's) or 1 to 10000")))
+        << bad;
+  }
+  nlohmann::json text = job_to_json(j);
+  text["horizon"] = 99.5;
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: horizon: expected an integer")));
+  text["horizon"] = "100";
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: horizon: expected an integer")));
+  text["horizon"] = 1e12;
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: horizon")));
+  text["horizon"] = std::int64_t{20000000000};
+  EXPECT_THAT([&] { job_from_json(text, "p.json"); }, ThrowsMessage<InputError>(HasSubstr("p.json: horizon: must be 0")));
+}
+
 TEST(JobSpec, ManifestPathsAreRecordedNotHashed) {
   JobSpec plain = golden_job();
   plain.pool = PoolRef{"reference9", std::string(64, 'e')};

@@ -31,7 +31,7 @@ struct MethodEntry {
 
 /// An experiment as written in YAML. Keys: name, tasks, splits, methods, seeds, episodes, backbone
 /// (required); pool (default null), rotation_mode (default "live"), profile (simulator fidelity,
-/// default "maniskill"), description (free text).
+/// default "maniskill"), horizon (control steps per episode, default the task's), description (free text).
 struct Experiment {
   std::string source;                 ///< file it was read from (for messages)
   std::string source_sha256;          ///< SHA-256 of the file bytes
@@ -48,6 +48,7 @@ struct Experiment {
   std::map<std::string, std::optional<std::string>> split_pools;
   std::string rotation_mode{"live"};  ///< "live" or "identity"
   std::string profile{"maniskill"};   ///< simulator fidelity profile: "maniskill" or "ideal"
+  int horizon{0};                     ///< control steps per episode; 0 (default): the task's
 };
 
 /// Parse experiment YAML text. `source` names it in errors.

@@ -108,8 +108,15 @@ struct JobSpec {
   /// Observation (sensor) noise sigma of the environment (sim::EnvConfig::obs_noise, docs/sim.md §6.1):
   /// 0 (default, off) or in (0, 0.1]. Hashed and recorded only when non-zero, so ids of jobs without noise are unchanged.
   double obs_noise{0.0};
+  /// Control steps per episode (sim::EnvConfig::horizon): 0 (default) is the task's (50; peg_insertion_side
+  /// 100), else 1..kMaxJobHorizon (the reference evaluates its Diffusion Policy at 100). Hashed and recorded
+  /// only when non-zero, so ids of jobs at the task's horizon are unchanged.
+  int horizon{0};
   bool operator==(const JobSpec&) const = default;
 };
+
+/// Largest horizon override a job may have (control steps per episode).
+inline constexpr int kMaxJobHorizon = 10000;
 
 /// Largest episode count a job may have.
 inline constexpr std::int64_t kMaxJobEpisodes = 1'000'000'000;
@@ -121,7 +128,7 @@ void validate_job(const JobSpec& job, const std::string& source = "job");
 /// "method":{"name","params"} (plus "plugin":{"files","kind","rung","sha256","version"} for a user method),"pool":{"name","sha256"}|null,"profile","rotation_mode","schema_version",
 /// "seed","split":{"contracts","name","sha256"},"task"}, plus "robot":{"packages","sha256","urdf"}
 /// only when the job names a robot, "policy_files":{"paths","sha256"} only when it names policy
-/// files, "obs_noise" (a float) only when it is non-zero, and "path" in "split" / "pool" only when the
+/// files, "obs_noise" (a float) and "horizon" (an integer) only when non-zero, and "path" in "split" / "pool" only when the
 /// manifest was given as a file. Validates first.
 nlohmann::json job_to_json(const JobSpec& job);
 

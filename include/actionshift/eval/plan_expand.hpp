@@ -52,6 +52,7 @@ struct JobRequest {
   std::uint64_t seed{20260718};       ///< experimental seed
   std::int64_t episodes{256};         ///< episodes
   double obs_noise{0.0};              ///< observation-noise sigma (run/render --obs-noise; 0 = off)
+  int horizon{0};                     ///< control steps per episode (run/render --horizon; 0 = the task's)
   std::string source{"command line"};  ///< where the request came from, named in its errors
 };
 
