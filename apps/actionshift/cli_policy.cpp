@@ -114,6 +114,13 @@ void register_policy_commands(CLI::App& app, CliContext& ctx) {
   dp->add_option("--ddim-steps", dp_o.dp.ddim_steps, "Sampler of the policy: 0 = DDPM over all 100 steps, else DDIM steps")->capture_default_str();
   dp->add_option("--lr", dp_o.dp.learn.learning_rate, "AdamW peak step size (500 warm-up steps, cosine decay)")->capture_default_str();
   dp->add_option("--threads", dp_o.dp.threads, "Threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();
+  dp->add_option("--checkpoint", dp_o.dp.checkpoint,
+                 "Checkpoint file: written every --checkpoint-every iterations; if it exists, training continues from\n"
+                 "it (only a checkpoint of the same settings), so a killed run re-run with the same command ends with\n"
+                 "the same bytes; removed once the weight file is written. Not part of the recorded command");
+  dp->add_option("--checkpoint-every", dp_o.dp.checkpoint_every, "Iterations between checkpoints")
+      ->check(CLI::Range(1, 1000000000))
+      ->capture_default_str();
   dp->add_option("--progress", dp_o.progress, "auto, bar or lines (one line per 50 iterations) or off")->capture_default_str();
   dp->callback([&] { ctx.action = [&] { return cli::run_train_dp(dp_o); }; });
   auto& gate0_o = ctx.make<cli::Gate0Options>();

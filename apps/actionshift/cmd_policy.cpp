@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -106,6 +107,7 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
     if (o.out.empty()) throw InputError("", "out", "a weight file is required (the backbone is then dp:FILE)");
     require_writable_output(o.out);
     if (o.progress != "off") (void)parse_progress_mode(o.progress);  // validates the mode
+    const int resume_at = policy::check_train_dp_checkpoint(t);  // a bad checkpoint is refused before anything is printed
     const std::string command = "actionshift train dp --task " + o.task + " --seed " + std::to_string(t.seed) + " --demos " +
                                 std::to_string(t.demos) + " --iterations " + std::to_string(t.iterations) + " --batch " +
                                 std::to_string(t.batch_size) + " --down-dims " + o.down_dims + " --ddim-steps " +
@@ -113,20 +115,24 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
     err << "train dp: " << o.task << ", U-Net " << hidden_text(t.down_dims) << " (" << policy::dp_parameter_count(arch)
         << " parameters), " << t.demos << " expert demos, " << t.iterations << " iterations x batch " << t.batch_size << ", seed "
         << t.seed << "\n";
+    if (resume_at > 0) err << "train dp: continuing from " << t.checkpoint << " at iteration " << resume_at << "\n";
     // the training curve beside the file (the file itself holds no timing, so it re-trains byte for byte)
     const std::string stem = o.out.size() > 5 && o.out.ends_with(".asdp") ? o.out.substr(0, o.out.size() - 5) : o.out;
     const std::string curve_path = stem + ".curve.jsonl";
-    std::ostringstream curve;
-    auto result = policy::train_dp(t, [&err, &o, &t, &curve](const policy::TrainDpProgress& p) {
-      curve << nlohmann::json{{"iteration", p.iteration}, {"loss", p.loss}, {"seconds", p.seconds}}.dump() << "\n";
+    auto result = policy::train_dp(t, [&err, &o, &t](const policy::TrainDpProgress& p) {
       if (o.progress == "off") return;
       err << "  iteration " << p.iteration << "/" << t.iterations << ": loss " << fmt(p.loss, 5) << ", " << fmt(p.seconds, 1) << " s\n";
     });
+    // the whole curve, the part before a resume included (it travels in the checkpoint)
+    std::ostringstream curve;
+    for (const auto& p : result.curve)
+      curve << nlohmann::json{{"iteration", p.iteration}, {"loss", p.loss}, {"seconds", p.seconds}}.dump() << "\n";
     const double per_iteration = result.train_seconds / t.iterations;
     curve << nlohmann::json{{"command", command},
                             {"collect_seconds", result.collect_seconds},
                             {"train_seconds", result.train_seconds},
                             {"seconds_per_iteration", per_iteration},
+                            {"resumed_at", result.resumed_at},
                             {"threads", policy::resolve_threads(t.threads)}}
                  .dump()
           << "\n";
@@ -145,6 +151,7 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
                                {"final_loss", result.final_loss}};
     policy::save_dp(result.weights, o.out);
     write_file_atomic(curve_path, curve.str());
+    if (!t.checkpoint.empty()) std::filesystem::remove(t.checkpoint);  // the weight file supersedes it
     const std::string bytes = policy::serialize_dp(result.weights);
     err << "train dp: " << result.demo_successes << "/" << t.demos << " demos kept, " << result.windows << " windows; "
         << fmt(per_iteration, 3) << " s per iteration (batch " << t.batch_size << ")\n";

@@ -94,6 +94,17 @@ DpLearner::DpLearner(const DpArch& arch, const DpLearnOptions& options, std::uin
   ema_ = params_;
 }
 
+void DpLearner::restore(State state) {
+  const std::size_t P = params_.size();
+  if (state.steps < 0 || state.params.size() != P || state.m.size() != P || state.v.size() != P || state.ema.size() != P)
+    throw std::invalid_argument("DpLearner::restore: the state is not of this network (" + std::to_string(P) + " parameters)");
+  t_ = state.steps;
+  params_ = std::move(state.params);
+  m_ = std::move(state.m);
+  v_ = std::move(state.v);
+  ema_ = std::move(state.ema);
+}
+
 double DpLearner::learning_rate(int n) const {
   // diffusers' get_cosine_schedule_with_warmup (the scheduler's counter is n - 1 at optimiser step n)
   const double s = n - 1;

@@ -1,7 +1,10 @@
 // Diffusion Policy: demonstrations from the scripted expert and the training loop (dp.hpp)
 #include "actionshift/policy/dp.hpp"
 
+#include "actionshift/core/atomic_file.hpp"
 #include "actionshift/core/error.hpp"
+#include "actionshift/core/hash.hpp"
+#include "actionshift/core/weight_file.hpp"
 #include "actionshift/core/workers.hpp"
 #include "actionshift/policy/expert.hpp"
 #include "actionshift/sim/env.hpp"
@@ -9,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <stdexcept>
 
@@ -25,6 +29,72 @@ struct Demo {
   bool success{false};
 };
 
+// ---- checkpoints: the learner's state, the batch sampler's position, the curve so far
+constexpr std::string_view kCheckpointMagic{"ASDPCKP\0", 8};
+constexpr std::uint32_t kCheckpointVersion = 1;
+
+// What decides the trained bytes (not threads, progress or the checkpoint itself): a checkpoint
+// continues only the run of the same settings.
+std::string settings_sha256(const TrainDpOptions& o) {
+  const DpLearnOptions& l = o.learn;
+  const nlohmann::json j = {{"task", std::string(sim::task_name(o.task))}, {"profile", o.profile}, {"seed", o.seed},
+                            {"down_dims", o.down_dims}, {"demos", o.demos}, {"iterations", o.iterations},
+                            {"batch_size", o.batch_size}, {"ddim_steps", o.ddim_steps}, {"log_every", o.log_every},
+                            {"learn", {l.learning_rate, l.beta1, l.beta2, l.eps, l.weight_decay, l.warmup_steps, l.ema_max_decay, l.shards}}};
+  return sha256_hex(j.dump());
+}
+
+struct Checkpoint {
+  DpLearner::State state;
+  double loss_sum{0.0};
+  int loss_n{0};
+  double train_seconds{0.0};
+  std::vector<TrainDpProgress> curve;
+};
+
+void write_checkpoint(const std::string& path, const std::string& settings, const Checkpoint& c) {
+  std::string payload;
+  for (const auto* v : {&c.state.params, &c.state.m, &c.state.v, &c.state.ema})
+    payload.append(reinterpret_cast<const char*>(v->data()), v->size() * sizeof(float));
+  nlohmann::json curve = nlohmann::json::array();
+  for (const auto& p : c.curve) curve.push_back({p.iteration, p.loss, p.seconds});
+  const nlohmann::json header = {{"format", "actionshift-dp-checkpoint"}, {"settings_sha256", settings},
+                                 {"iteration", c.state.steps},            {"parameters", c.state.params.size()},
+                                 {"loss_sum", c.loss_sum},                {"loss_n", c.loss_n},
+                                 {"train_seconds", c.train_seconds},      {"curve", curve},
+                                 {"payload_sha256", sha256_hex(payload)}};
+  write_file_atomic(path, weight_file::frame(kCheckpointMagic, kCheckpointVersion, header, payload));
+}
+
+Checkpoint read_checkpoint(const std::string& path, const std::string& settings, std::size_t parameters, int iterations) {
+  const std::string bytes = weight_file::read(path, std::uintmax_t{4} << 30, "Diffusion Policy checkpoint");
+  const weight_file::Unframed u = weight_file::unframe(bytes, kCheckpointMagic, kCheckpointVersion, path, "Diffusion Policy checkpoint");
+  const nlohmann::json& h = u.header;
+  try {
+    if (h.at("settings_sha256").get<std::string>() != settings)
+      throw InputError(path, "settings_sha256",
+                       "written by a train dp run with other settings (task, seed, demos, iterations, network or optimiser); "
+                       "delete it or give another --checkpoint");
+    if (h.at("parameters").get<std::size_t>() != parameters) throw InputError(path, "parameters", "not this network's parameter count");
+    weight_file::check_payload(u, 4 * static_cast<std::int64_t>(parameters), path, true);
+    Checkpoint c;
+    c.state.steps = h.at("iteration").get<int>();
+    if (c.state.steps < 0 || c.state.steps > iterations) throw InputError(path, "iteration", "outside this run's iterations");
+    c.loss_sum = h.at("loss_sum").get<double>();
+    c.loss_n = h.at("loss_n").get<int>();
+    c.train_seconds = h.at("train_seconds").get<double>();
+    for (const auto& p : h.at("curve")) c.curve.push_back({p.at(0).get<int>(), p.at(1).get<double>(), p.at(2).get<double>()});
+    const auto* f = reinterpret_cast<const float*>(u.payload.data());
+    for (auto* v : {&c.state.params, &c.state.m, &c.state.v, &c.state.ema}) {
+      v->assign(f, f + parameters);
+      f += parameters;
+    }
+    return c;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "header", std::string("malformed checkpoint header: ") + e.what());
+  }
+}
+
 }  // namespace
 
 void check_train_dp_options(const TrainDpOptions& o) {
@@ -32,6 +102,7 @@ void check_train_dp_options(const TrainDpOptions& o) {
   if (o.iterations <= 0) throw InputError("", "iterations", "must be positive");
   if (o.batch_size <= 0) throw InputError("", "batch", "must be positive");
   if (o.log_every <= 0) throw InputError("", "log-every", "must be positive");
+  if (o.checkpoint_every <= 0) throw InputError("", "checkpoint-every", "must be positive");
   if (!(o.learn.learning_rate > 0) || !std::isfinite(o.learn.learning_rate)) throw InputError("", "lr", "must be positive");
   try {
     (void)sim::profile_config(o.profile);
@@ -48,6 +119,15 @@ void check_train_dp_options(const TrainDpOptions& o) {
   }
   if (o.ddim_steps < 0 || o.ddim_steps > arch.diffusion_steps)
     throw InputError("", "ddim-steps", "must be in [0, " + std::to_string(arch.diffusion_steps) + "] (0: DDPM)");
+}
+
+int check_train_dp_checkpoint(const TrainDpOptions& o) {
+  check_train_dp_options(o);
+  if (o.checkpoint.empty() || !std::filesystem::exists(o.checkpoint)) return 0;
+  DpArch arch;
+  arch.obs_dim = sim::observation_layout(o.task).size();
+  arch.down_dims = o.down_dims;
+  return read_checkpoint(o.checkpoint, settings_sha256(o), static_cast<std::size_t>(dp_parameter_count(arch)), o.iterations).state.steps;
 }
 
 TrainDpResult train_dp(const TrainDpOptions& o, const std::function<void(const TrainDpProgress&)>& progress) {
@@ -148,19 +228,40 @@ TrainDpResult train_dp(const TrainDpOptions& o, const std::function<void(const T
   std::vector<DpVec<float>> conds(static_cast<std::size_t>(o.batch_size));
   double loss_sum = 0.0;
   int loss_n = 0;
-  for (int it = 1; it <= o.iterations; ++it) {
+  double seconds_before = 0.0;  // training time of the runs before a resume
+  const std::string settings = o.checkpoint.empty() ? std::string() : settings_sha256(o);
+  if (!o.checkpoint.empty() && std::filesystem::exists(o.checkpoint)) {
+    Checkpoint c = read_checkpoint(o.checkpoint, settings, learner.params().size(), o.iterations);
+    // the sampler's position: the same draws as the iterations already done (a few per iteration)
+    for (int it = 0; it < c.state.steps; ++it)
+      for (int b = 0; b < o.batch_size; ++b) (void)batch_rng.uniform_int(windows.size());
+    result.resumed_at = c.state.steps;
+    loss_sum = c.loss_sum;
+    loss_n = c.loss_n;
+    seconds_before = c.train_seconds;
+    result.curve = std::move(c.curve);
+    if (!result.curve.empty()) result.final_loss = result.curve.back().loss;
+    learner.restore(std::move(c.state));
+  }
+  const double train_start = elapsed();
+  auto train_seconds = [&] { return seconds_before + elapsed() - train_start; };
+  for (int it = result.resumed_at + 1; it <= o.iterations; ++it) {
     for (int b = 0; b < o.batch_size; ++b)
       window(static_cast<std::size_t>(batch_rng.uniform_int(windows.size())), chunks[static_cast<std::size_t>(b)], conds[static_cast<std::size_t>(b)]);
     loss_sum += learner.step(chunks, conds, threads);
     ++loss_n;
     if (it % o.log_every == 0 || it == o.iterations) {
       result.final_loss = loss_sum / loss_n;
-      if (progress) progress({it, result.final_loss, elapsed()});
+      const TrainDpProgress p{it, result.final_loss, result.collect_seconds + train_seconds()};
+      result.curve.push_back(p);
+      if (progress) progress(p);
       loss_sum = 0.0;
       loss_n = 0;
     }
+    if (!o.checkpoint.empty() && it % o.checkpoint_every == 0 && it < o.iterations)
+      write_checkpoint(o.checkpoint, settings, {learner.state(), loss_sum, loss_n, train_seconds(), result.curve});
   }
-  result.train_seconds = elapsed() - result.collect_seconds;
+  result.train_seconds = train_seconds();
   w.params = learner.ema();
   result.weights = std::move(w);
   return result;

@@ -4,10 +4,16 @@
 #include "actionshift/core/rng.hpp"
 #include "actionshift/policy/dp.hpp"
 
+#include "actionshift/core/error.hpp"
+
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <vector>
 
@@ -189,6 +195,57 @@ TEST(DpLearner, SameBytesWithOneAndTwoThreads) {
   // and the weights moved
   const DpLearner fresh(toy_arch(), o, 77);
   EXPECT_NE(std::memcmp(a.params().data(), fresh.params().data(), a.params().size() * sizeof(float)), 0);
+}
+
+// train_dp with a checkpoint: a run stopped after its checkpoint at iteration 4 and started again
+// ends with the bytes of a run never stopped (weights, EMA, final loss, curve); a checkpoint of other
+// settings or a damaged one is refused with the file named
+TEST(TrainDp, AnInterruptedRunContinuesFromItsCheckpointToTheSameBytes) {
+  TrainDpOptions o;
+  o.demos = 2;
+  o.iterations = 6;
+  o.batch_size = 4;
+  o.down_dims = {8, 16};
+  o.threads = 1;
+  o.log_every = 1;
+  const TrainDpResult whole = train_dp(o);
+  const std::string want = serialize_dp(whole.weights);
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("as_dp_ckpt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  o.checkpoint = (dir / "run.ckpt").string();
+  o.checkpoint_every = 2;
+  struct Stop {};
+  EXPECT_THROW(train_dp(o, [](const TrainDpProgress& p) { if (p.iteration == 5) throw Stop{}; }), Stop);
+  ASSERT_TRUE(std::filesystem::exists(o.checkpoint));
+  const TrainDpResult resumed = train_dp(o);
+  EXPECT_EQ(resumed.resumed_at, 4);
+  EXPECT_EQ(serialize_dp(resumed.weights), want);
+  EXPECT_EQ(std::memcmp(&resumed.final_loss, &whole.final_loss, sizeof(double)), 0);
+  ASSERT_EQ(resumed.curve.size(), whole.curve.size());
+  for (std::size_t i = 0; i < whole.curve.size(); ++i) {
+    EXPECT_EQ(resumed.curve[i].iteration, whole.curve[i].iteration);
+    EXPECT_EQ(resumed.curve[i].loss, whole.curve[i].loss) << i;
+  }
+
+  // the checkpoint of iteration 4 is still there (the caller removes it): other settings refuse it
+  TrainDpOptions other = o;
+  other.seed += 1;
+  EXPECT_THAT([&] { train_dp(other); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(o.checkpoint + ": settings_sha256")));
+  // a damaged one is named, not trusted
+  std::string bytes;
+  {
+    std::ifstream in(o.checkpoint, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  bytes[bytes.size() - 3] ^= 0x5a;
+  std::ofstream(o.checkpoint, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_THAT([&] { train_dp(o); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(o.checkpoint + ": payload: checksum mismatch")));
+  std::ofstream(o.checkpoint, std::ios::binary | std::ios::trunc) << "not a checkpoint";
+  EXPECT_THAT([&] { train_dp(o); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(o.checkpoint + ": magic")));
+  o.checkpoint_every = 0;
+  EXPECT_THAT([&] { check_train_dp_options(o); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("checkpoint-every")));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(DpLearner, RejectsBadBatches) {

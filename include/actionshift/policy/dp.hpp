@@ -169,6 +169,16 @@ class DpLearner {
   const std::vector<float>& params() const { return params_; }
   const std::vector<float>& ema() const { return ema_; }
   int steps_done() const { return t_; }
+
+  /// Everything step() changes: a checkpoint of these continues training bit for bit.
+  struct State {
+    int steps{0};                               ///< optimiser steps done
+    std::vector<float> params, m, v, ema;       ///< weights, AdamW moments, EMA weights
+  };
+  State state() const { return {t_, params_, m_, v_, ema_}; }
+  /// Continue from `state` (the same architecture, options and seed). Throws std::invalid_argument
+  /// if a vector's size is not the network's parameter count or steps is negative.
+  void restore(State state);
   /// Step size of the (1-based) optimiser step n.
   double learning_rate(int n) const;
   /// EMA decay of the (1-based) update n.
@@ -285,14 +295,25 @@ struct TrainDpOptions {
   DpLearnOptions learn;                    ///< AdamW, warm-up + cosine (total = iterations), EMA
   unsigned threads{0};                     ///< demonstration and gradient threads (0 = all cores)
   int log_every{50};                       ///< progress callback period (iterations)
+  /// A checkpoint file ("" = none): written atomically every `checkpoint_every` iterations, and, when it
+  /// exists at the start, training continues from it, so an interrupted run ends with the same bytes as
+  /// an uninterrupted one. A checkpoint written by other settings is refused (InputError naming it).
+  std::string checkpoint;
+  int checkpoint_every{500};               ///< iterations between checkpoints
 };
 
 /// The checks train_dp makes before it starts (the CLI makes them before it writes anything): demos,
-/// iterations, batch size and log period positive, the learning rate positive and finite, the
+/// iterations, batch size, log and checkpoint periods positive, the learning rate positive and finite, the
 /// profile known, the U-Net widths valid for the task (DpArch::validate), ddim_steps in [0, 100].
 /// Messages name the fields as the `train dp` options spell them ("down-dims: ..."). Throws
 /// actionshift::InputError.
 void check_train_dp_options(const TrainDpOptions& options);
+
+/// If options.checkpoint names an existing file, reads and checks it as train_dp would before it
+/// continues from it (frame, checksum, the same settings, the iteration): the CLI's check before it
+/// prints anything. Returns the iteration it holds, or 0 without a checkpoint. Throws
+/// actionshift::InputError naming the file.
+int check_train_dp_checkpoint(const TrainDpOptions& options);
 
 /// Progress of `train dp`.
 struct TrainDpProgress {
@@ -307,6 +328,8 @@ struct TrainDpResult {
   std::int64_t windows{0};           ///< training windows in the data set
   double collect_seconds{0.0}, train_seconds{0.0};
   double final_loss{0.0};            ///< mean loss over the last log period
+  std::vector<TrainDpProgress> curve;  ///< every progress report, those before a resume included
+  int resumed_at{0};                 ///< iteration the run continued from (0: from the start)
 };
 
 /// Collect expert demonstrations and train a Diffusion Policy. Throws std::invalid_argument for bad
