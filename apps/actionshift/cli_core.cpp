@@ -83,7 +83,7 @@ void register_core_commands(CLI::App& app, CliContext& ctx) {
                "orientation turns slowly. Reports the first selection of an episode (from the uniform belief),\n"
                "encode on probe and on task steps, observe (the belief update) and the whole step, in microseconds\n"
                "(medians over repetitions, one thread). See docs/results/benchmarks.md.");
-  bench_adapt->add_option("--method", bench_adapt_o.method, "Adapter method (docs/adapters.md)")->capture_default_str();
+  bench_adapt->add_option("--method", bench_adapt_o.bench.method, "Adapter method (docs/adapters.md)")->capture_default_str();
   bench_adapt->add_option("--pool", bench_adapt_o.pool, "Declared pool: reference9, full or a pool manifest file (pool methods)")
       ->capture_default_str();
   bench_adapt->add_option("--params", bench_adapt_o.params, "Method parameters as a JSON object (defaults: docs/adapters.md)")
@@ -92,12 +92,11 @@ void register_core_commands(CLI::App& app, CliContext& ctx) {
       ->capture_default_str();
   bench_adapt->add_option("--profile", bench_adapt_o.profile, "Simulator fidelity profile of that calibration: maniskill or ideal")->check(kProfile)
       ->capture_default_str();
-  bench_adapt->add_option("--episodes", bench_adapt_o.episodes, "Episodes per repetition")->capture_default_str()->check(CLI::PositiveNumber);
-  bench_adapt->add_option("--steps", bench_adapt_o.steps, "Control steps per episode")->capture_default_str()->check(CLI::PositiveNumber);
-  bench_adapt->add_option("--repetitions", bench_adapt_o.repetitions, "Repetitions (the figures are their medians)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  bench_adapt->add_option("--seed", bench_adapt_o.seed, "Seed of the synthetic episodes")->check(kSeed)->capture_default_str();
+  bench_adapt->add_option("--episodes", bench_adapt_o.bench.episodes, "Episodes per repetition")->capture_default_str();
+  bench_adapt->add_option("--steps", bench_adapt_o.bench.steps, "Control steps per episode")->capture_default_str();
+  bench_adapt->add_option("--repetitions", bench_adapt_o.bench.repetitions, "Repetitions (the figures are their medians)")
+      ->capture_default_str();
+  bench_adapt->add_option("--seed", bench_adapt_o.bench.seed, "Seed of the synthetic episodes")->check(kSeed)->capture_default_str();
   bench_adapt->add_flag("--json", bench_adapt_o.json, "Print one JSON object");
   bench_adapt->callback([&] { ctx.action = [&] { return cli::run_bench_adapt(bench_adapt_o); }; });
 }

@@ -16,12 +16,12 @@
 namespace actionshift::cli {
 
 int run_bench_adapt(const BenchAdaptOptions& o) {
-  adapt::AdapterBenchConfig cfg;
-  cfg.method = o.method;
+  adapt::AdapterBenchConfig cfg = o.bench;
+  const std::string& method = cfg.method;
   cfg.params = parse_json_input(o.params, "command line", "--params");
   if (!cfg.params.is_object()) throw InputError("", "--params", "must be a JSON object");
-  cfg.params = adapt::resolve_method_params(o.method, cfg.params);  // unknown method / parameter: InputError
-  if (adapt::method_needs_pool(o.method)) {
+  cfg.params = adapt::resolve_method_params(method, cfg.params);  // unknown method / parameter: InputError
+  if (adapt::method_needs_pool(method)) {
     const Manifest m = data::resolve_manifest(o.pool);
     if (!m.is_pool()) throw InputError(o.pool, "kind", "is a split manifest, not a pool");
     cfg.pool = m.contracts();
@@ -29,25 +29,21 @@ int run_bench_adapt(const BenchAdaptOptions& o) {
   const auto text = data::builtin_calibration_text(o.task, o.profile);
   if (!text) throw InputError("--task", o.task, "no built-in calibration for this task on profile '" + o.profile + "'");
   cfg.model = adapt::ResponseCalibration::from_json(std::string(*text), "builtin:calibration/" + o.profile + "/" + o.task).model();
-  cfg.episodes = o.episodes;
-  cfg.steps = o.steps;
-  cfg.repetitions = o.repetitions;
-  cfg.seed = o.seed;
   const adapt::AdapterBenchResult r = adapt::bench_adapter(cfg);
   if (o.json) {
     nlohmann::json j = r.to_json();
-    j["pool"] = adapt::method_needs_pool(o.method) ? nlohmann::json(o.pool) : nlohmann::json(nullptr);
+    j["pool"] = adapt::method_needs_pool(method) ? nlohmann::json(o.pool) : nlohmann::json(nullptr);
     j["task"] = o.task;
     j["profile"] = o.profile;
-    j["episodes"] = o.episodes;
-    j["steps"] = o.steps;
-    j["repetitions"] = o.repetitions;
+    j["episodes"] = cfg.episodes;
+    j["steps"] = cfg.steps;
+    j["repetitions"] = cfg.repetitions;
     std::cout << j.dump() << "\n";
     return kOk;
   }
   std::printf("%s on %s (%d hypotheses), %s/%s response model: %d episodes x %d steps, medians of %d repetitions\n",
-              o.method.c_str(), adapt::method_needs_pool(o.method) ? o.pool.c_str() : "no pool", r.hypotheses, o.profile.c_str(),
-              o.task.c_str(), o.episodes, o.steps, o.repetitions);
+              method.c_str(), adapt::method_needs_pool(method) ? o.pool.c_str() : "no pool", r.hypotheses, o.profile.c_str(),
+              o.task.c_str(), cfg.episodes, cfg.steps, cfg.repetitions);
   std::printf("  first encode (selection from the uniform belief) %10.2f us\n", r.first_select_us);
   std::printf("  encode on a probe step                           %10.2f us  (%.2f probes per episode)\n", r.probe_encode_us,
               r.probes_per_episode);

@@ -45,6 +45,10 @@ expect_err "not a pool" "split as pool"
 run "$AS" bench adapt --method entropy_probes --task no_such_task
 expect_rc 2 "unknown task"
 expect_one_line_error "unknown task"
-run "$AS" bench adapt --method entropy_probes --episodes 0
-expect_rc 2 "zero episodes"
+for opt in episodes steps repetitions; do
+  run "$AS" bench adapt --method entropy_probes --$opt 0
+  expect_rc 2 "zero $opt"
+  expect_one_line_error "zero $opt"
+  expect_err "$opt: must be at least 1" "zero $opt names the option"
+done
 finish
