@@ -459,7 +459,7 @@ def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, c
 def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=20260718, episodes=256,
              out="results", backbone=None, pool=None, params=None, rotation="live", profile="maniskill",
              progress="off", threads=1, policy_version=None, policy_files=None, *, robot=None, packages=None,
-             obs_noise=0.0, calibration=None):
+             obs_noise=0.0, calibration=None, horizon=0):
     """Run ``policy`` (a callable obs -> 7 canonical numbers; its ``reset()`` is called at each
     episode start if it has one; or the name of one of the library's backbones, ``"expert"``,
     ``"ppo"``, ``"mlp:DIR"``, as ``actionshift run --backbone`` takes it) as the backbone of one hash-addressed job, in this process,
@@ -495,6 +495,10 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     ``calibration`` (a dict as ``calibrate --json`` writes it, or its file) is for a method that uses
     one, instead of the task's built-in calibration.
 
+    horizon: control steps per episode, 0 (the default) for the task's (50; peg_insertion_side 100), as
+    ``actionshift run --horizon`` takes it: a job names a horizon only when it is not 0, so its id is the CLI's.
+    The reference evaluates its Diffusion Policy at 100.
+
     Identity (docs/methods.md): a Python policy enters the job id by its content (its code, closure
     and global values, its attributes, ``policy_files``), so two different callables never share a
     job; ``policy_version="..."`` names it instead of its code (for a policy whose content cannot be
@@ -521,6 +525,7 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
     if not isinstance(obs_noise, (int, float, _np.floating, _np.integer)) or isinstance(obs_noise, bool):
         raise TypeError(f"evaluate: obs_noise: expected a number (got {type(obs_noise).__name__})")
     for name, value, lo, hi, why in (("episodes", episodes, 1, 2 ** 62, "must be > 0 and at most 2**62"),
+                                     ("horizon", horizon, 0, 10000, "must be 0 (the task's) or 1 to 10000 control steps"),
                                      ("threads", threads, 0, 4096, "must be 0 (all cores) or a count up to 4096")):
         if not isinstance(value, (int, _np.integer)) or isinstance(value, bool):
             raise TypeError(f"evaluate: {name}: expected int (got {type(value).__name__})")
@@ -551,7 +556,7 @@ def evaluate(policy, task="pick_cube", split="seen", method="no_adapt", seed=202
                              None if pool is None else _os.fspath(pool),
                              params, rotation, profile, progress, int(threads), method_object, method_identity,
                              backbone_sha256, _robot_arg(robot), _packages_args("evaluate", packages), float(obs_noise),
-                             calibration)
+                             calibration, int(horizon))
 
 
 def _json_lines(fin):

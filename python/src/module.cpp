@@ -1179,7 +1179,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
                   std::optional<std::string> pool, py::object params, const std::string& rotation,
                   const std::string& profile, const std::string& progress, int threads, py::object method_object,
                   py::object method_identity, std::optional<std::string> backbone_sha256, std::optional<std::string> robot,
-                  const std::vector<std::string>& packages, double obs_noise, py::object calibration) {
+                  const std::vector<std::string>& packages, double obs_noise, py::object calibration, int horizon) {
   // a string names a backbone of the library (expert, mlp:..., ppo:..., external:...), as `run --backbone`
   const bool builtin_backbone = py::isinstance<py::str>(policy);
   if (!builtin_backbone && !PyCallable_Check(policy.ptr()))
@@ -1198,6 +1198,7 @@ py::dict evaluate(py::object policy, const std::string& task, const std::string&
   q.seed = seed;
   q.episodes = episodes;
   q.obs_noise = obs_noise;
+  q.horizon = horizon;  // checked with the job (validate_job): 0 is the task's
   q.source = "evaluate";
   if (!(obs_noise >= 0.0 && obs_noise <= sim::kMaxObsNoise)) {  // also rejects NaN
     std::ostringstream got;
@@ -1832,7 +1833,7 @@ PYBIND11_MODULE(_native, m) {
         py::arg("rotation"), py::arg("profile"), py::arg("progress"), py::arg("threads"), py::arg("method_object") = py::none(),
         py::arg("method_identity") = py::none(), py::arg("backbone_sha256") = py::none(),
         py::arg("robot") = py::none(), py::arg("packages") = std::vector<std::string>{}, py::arg("obs_noise") = 0.0,
-        py::arg("calibration") = py::none());
+        py::arg("calibration") = py::none(), py::arg("horizon") = 0);
   m.def("job_id", [](py::handle spec) { return eval::job_id(eval::job_from_json(nlohmann::json::parse(py_to_json(spec, "job")), "job")); },
         py::arg("job"));
 

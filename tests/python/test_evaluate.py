@@ -219,3 +219,24 @@ def test_robot_noise_and_calibration_make_the_clis_job(tmp_path, cli, source_dir
     with pytest.raises(TypeError, match="obs_noise: expected a number"):
         actionshift.evaluate("expert", out=str(tmp_path / "bad"), episodes=1, obs_noise="0.1")
     assert not (tmp_path / "bad").exists() or not any((tmp_path / "bad").iterdir())
+
+
+def test_horizon_makes_the_clis_job(tmp_path, cli):
+    # evaluate(horizon=) is `run --horizon`: the same job id and records; 0 is the task's horizon (the job
+    # of no option), another horizon is another job whose episodes run exactly that many steps
+    common = dict(task="push_cube", split="seen", method="oracle", seed=7, episodes=2)
+    plain = actionshift.evaluate("expert", out=str(tmp_path / "plain"), **common)
+    zero = actionshift.evaluate("expert", out=str(tmp_path / "zero"), horizon=0, **common)
+    assert zero["job_id"] == plain["job_id"] and "horizon" not in plain["job"]
+    r = actionshift.evaluate("expert", out=str(tmp_path / "py"), horizon=9, **common)
+    assert r["job"]["horizon"] == 9 and r["job_id"] != plain["job_id"]
+    steps = [json.loads(line)["steps"] for line in open(r["jsonl_path"])]
+    assert steps == [9, 9]
+    out = cli("run", "--task", "push_cube", "--split", "seen", "--method", "oracle", "--seed", "7", "--episodes", "2",
+              "--backbone", "expert", "--horizon", "9", "--out", str(tmp_path / "cli"), "--progress", "off", check=0).stdout
+    assert out.startswith(r["job_id"] + " ")
+    assert (tmp_path / "py" / f"{r['job_id']}.jsonl").read_bytes() == (tmp_path / "cli" / f"{r['job_id']}.jsonl").read_bytes()
+    for bad, exc in ((-1, ValueError), (10001, ValueError), (2.5, TypeError), (True, TypeError)):
+        with pytest.raises(exc, match="horizon") as e:
+            actionshift.evaluate("expert", out=str(tmp_path / "bad"), horizon=bad, **common)
+        assert "\n" not in str(e.value)
