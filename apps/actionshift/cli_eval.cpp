@@ -6,6 +6,8 @@
 #include "cmd_run.hpp"
 #include "commands.hpp"
 
+#include "actionshift/sim/env.hpp"
+
 #include <cstdint>
 #include <iostream>
 
@@ -54,7 +56,7 @@ void add_job_options(CliContext& ctx, CLI::App* cmd, CliJobOptions& j, bool requ
   cmd->add_option("--horizon", j.request.horizon,
                   "Control steps per episode (0: the task's, 50; peg_insertion_side 100); part of the job id when\n"
                   "not 0 (the reference evaluates its Diffusion Policy at 100)")
-      ->check(CLI::Range(0, eval::kMaxJobHorizon))
+      ->check(CLI::Range(0, sim::kMaxHorizon))
       ->capture_default_str();
   cmd->add_option("--calibration", j.calibration,
                   "Response calibration file for a method that needs one, instead of the task's built-in one (e.g.\n"

@@ -4,6 +4,8 @@
 #include "cmd_identifier.hpp"
 #include "cmd_policy.hpp"
 
+#include "actionshift/sim/env.hpp"
+
 #include <iostream>
 
 namespace actionshift::cli {
@@ -139,7 +141,7 @@ void register_policy_commands(CLI::App& app, CliContext& ctx) {
   gate0->add_option("--horizon", gate0_o.run.horizon,
                     "Control steps per episode (default 0: the task's, 50; peg_insertion_side 100). The reference\n"
                     "evaluates its Diffusion Policy at 100 on every task; the verdict records a horizon given here")
-      ->check(CLI::Range(0, policy::kMaxGate0Horizon))
+      ->check(CLI::Range(0, sim::kMaxHorizon))
       ->capture_default_str();
   gate0->add_option("--rule", gate0_o.rule, "Competence statistic: wilson_lower or point_estimate")->capture_default_str();
   gate0->add_option("--threads", gate0_o.run.threads, "Worker threads (0: all cores; at most 1024)")->check(CLI::Range(0, 1024))->capture_default_str();

@@ -6,6 +6,7 @@
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/eval/job.hpp"
+#include "actionshift/sim/env.hpp"
 #include "io.hpp"
 #include "plan_detail.hpp"
 
@@ -337,10 +338,8 @@ Experiment parse_experiment(std::string_view text, const std::string& source) {
   }
   if (root["horizon"]) {
     const auto h = as_int(root["horizon"]);
-    if (!h || *h < 0 || *h > kMaxJobHorizon)
-      throw InputError(at_line(source, root["horizon"]), "horizon",
-                       "expected control steps per episode, 0 (the task's) to " + std::to_string(kMaxJobHorizon) + " (got " +
-                           yaml_text(root["horizon"]) + ")");
+    if (!h) throw InputError(at_line(source, root["horizon"]), "horizon", "expected an integer number of control steps (got " + yaml_text(root["horizon"]) + ")");
+    sim::check_horizon(*h, at_line(source, root["horizon"]));
     ex.horizon = static_cast<int>(*h);
   }
   return ex;

@@ -110,9 +110,7 @@ void validate_job(const JobSpec& job, const std::string& src) {
     got << job.obs_noise;
     throw InputError(src, "obs_noise", "must be a finite sigma in [0, 0.1] (metres / radians; got " + got.str() + ")");
   }
-  if (job.horizon < 0 || job.horizon > kMaxJobHorizon)
-    throw InputError(src, "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxJobHorizon) + " control steps (got " +
-                                         std::to_string(job.horizon) + ")");
+  sim::check_horizon(job.horizon, src);
   if (job.policy_files) {
     check_hash(job.policy_files->sha256, src, "policy_files.sha256");
     if (job.policy_files->paths.empty()) throw InputError(src, "policy_files.paths", "must name at least one file");
@@ -179,9 +177,7 @@ JobSpec job_from_json(const nlohmann::json& j, const std::string& src) {
     const json& v = j.at("horizon");
     if (!v.is_number_integer()) throw InputError(src, "horizon", "expected an integer number of control steps");
     const auto h = v.get<std::int64_t>();
-    if (h < 0 || h > kMaxJobHorizon)
-      throw InputError(src, "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxJobHorizon) + " control steps (got " +
-                                           std::to_string(h) + ")");
+    sim::check_horizon(h, src);
     job.horizon = static_cast<int>(h);
     validate_job(job, src);
     return job;

@@ -102,9 +102,7 @@ Gate0Verdict gate0_verdict(std::string_view backbone, std::string_view sha, sim:
 
 void check_gate0_run(const Gate0Run& run) {
   if (run.episodes <= 0) throw InputError("", "episodes", "at least one episode is required");
-  if (run.horizon < 0 || run.horizon > kMaxGate0Horizon)
-    throw InputError("", "horizon", "must be 0 (the task's) or 1 to " + std::to_string(kMaxGate0Horizon) + " control steps, got " +
-                                        std::to_string(run.horizon));
+  sim::check_horizon(run.horizon, "");
 }
 
 Gate0Verdict run_gate0(const Policy& policy, const Gate0Run& run) {

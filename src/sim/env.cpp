@@ -1,6 +1,7 @@
 // env model (shared, immutable) and env (per worker): reset, step, observations, safety checks
 #include "actionshift/sim/env.hpp"
 
+#include "actionshift/core/error.hpp"
 #include "actionshift/core/rng.hpp"
 #include "obs_noise.hpp"
 #include "physics_world.hpp"
@@ -363,6 +364,12 @@ const StepResult& Env::abort(SafetyFlag flag) {
   if (!e.started) throw std::logic_error("Env::abort called before reset");
   if (e.last.episode_over() || flag == SafetyFlag::kNone) return e.last;
   return end_episode(e, flag);
+}
+
+void check_horizon(long long horizon, const std::string& source, const std::string& field) {
+  if (horizon < 0 || horizon > kMaxHorizon)
+    throw InputError(source, field, "must be 0 (the task's) or 1 to " + std::to_string(kMaxHorizon) + " control steps (got " +
+                                        std::to_string(horizon) + ")");
 }
 
 }  // namespace actionshift::sim

@@ -1,6 +1,7 @@
 #include "actionshift/eval/job.hpp"
 
 #include "actionshift/core/error.hpp"
+#include "actionshift/sim/env.hpp"
 #include "actionshift/core/hash.hpp"
 
 #include <gmock/gmock.h>
@@ -171,7 +172,7 @@ TEST(JobSpec, HorizonEntersTheSpecAndTheIdOnlyWhenNonZero) {
   const JobSpec back = job_from_json(job_to_json(j), "plan.json");
   EXPECT_EQ(back, j);
   EXPECT_EQ(job_id(back), job_id(j));
-  for (int bad : {-1, kMaxJobHorizon + 1}) {
+  for (int bad : {-1, sim::kMaxHorizon + 1}) {
     JobSpec b = golden_job();
     b.horizon = bad;
     EXPECT_THAT([&] { validate_job(b, "cli"); }, ThrowsMessage<InputError>(HasSubstr("cli: horizon: must be 0 (the task's) or 1 to 10000")))

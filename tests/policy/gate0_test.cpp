@@ -92,7 +92,7 @@ TEST(Gate0, AHorizonOverrideSetsTheEpisodeLengthAndIsRecordedOnlyWhenGiven) {
   EXPECT_EQ(policy::gate0_to_json({seven}).at("cells").at("counting/push_cube").at("horizon"), 7);
   run.horizon = -1;
   EXPECT_THAT([&] { policy::check_gate0_run(run); }, ::testing::ThrowsMessage<InputError>(HasSubstr("horizon")));
-  run.horizon = policy::kMaxGate0Horizon + 1;
+  run.horizon = sim::kMaxHorizon + 1;
   EXPECT_THAT([&] { policy::run_gate0(counting, run); }, ::testing::ThrowsMessage<InputError>(HasSubstr("horizon")));
 }
 

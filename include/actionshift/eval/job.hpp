@@ -109,14 +109,11 @@ struct JobSpec {
   /// 0 (default, off) or in (0, 0.1]. Hashed and recorded only when non-zero, so ids of jobs without noise are unchanged.
   double obs_noise{0.0};
   /// Control steps per episode (sim::EnvConfig::horizon): 0 (default) is the task's (50; peg_insertion_side
-  /// 100), else 1..kMaxJobHorizon (the reference evaluates its Diffusion Policy at 100). Hashed and recorded
+  /// 100), else 1..sim::kMaxHorizon (the reference evaluates its Diffusion Policy at 100). Hashed and recorded
   /// only when non-zero, so ids of jobs at the task's horizon are unchanged.
   int horizon{0};
   bool operator==(const JobSpec&) const = default;
 };
-
-/// Largest horizon override a job may have (control steps per episode).
-inline constexpr int kMaxJobHorizon = 10000;
 
 /// Largest episode count a job may have.
 inline constexpr std::int64_t kMaxJobEpisodes = 1'000'000'000;

@@ -67,9 +67,6 @@ Gate0Competence gate0_competence(std::int64_t successes, std::int64_t total, dou
 Gate0Parity gate0_parity(std::int64_t ref_successes, std::int64_t ref_total, std::int64_t wrap_successes,
                          std::int64_t wrap_total, double tolerance = kGate0ParityTolerance);
 
-/// Largest horizon a Gate 0 run accepts (control steps).
-inline constexpr int kMaxGate0Horizon = 10000;
-
 /// Settings of a Gate 0 run.
 struct Gate0Run {
   std::string profile{"maniskill"};  ///< simulator fidelity profile (sim::profile_config)
@@ -89,7 +86,7 @@ struct Gate0Run {
 };
 
 /// The checks run_gate0 makes before any episode (the CLI makes them before it builds the backbone):
-/// at least one episode, a horizon in [0, kMaxGate0Horizon]. Throws actionshift::InputError.
+/// at least one episode, a horizon in [0, sim::kMaxHorizon]. Throws actionshift::InputError.
 void check_gate0_run(const Gate0Run& run);
 
 /// A Gate 0 verdict for one backbone and task.

@@ -79,6 +79,12 @@ inline constexpr std::string_view kDefaultProfile = "maniskill";
 
 /// Largest accepted EnvConfig::obs_noise (metres / radians): 10 cm of sensor noise is no sensor.
 inline constexpr double kMaxObsNoise = 0.1;
+/// Largest EnvConfig::horizon a run, a job or a Gate 0 accepts (control steps per episode).
+inline constexpr int kMaxHorizon = 10000;
+/// The one check of a horizon given by a user (`--horizon`, the experiment key, a job spec):
+/// throws actionshift::InputError(source, field, "must be 0 (the task's) or 1 to 10000 control steps (got H)")
+/// unless 0 <= horizon <= kMaxHorizon.
+void check_horizon(long long horizon, const std::string& source, const std::string& field = "horizon");
 
 /// Settings of an environment model. The defaults are the `maniskill` fidelity profile.
 struct EnvConfig {
