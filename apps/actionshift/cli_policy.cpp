@@ -129,7 +129,8 @@ void register_policy_commands(CLI::App& app, CliContext& ctx) {
   auto* gate0 = app.add_subcommand(
       "gate0", "Gate 0 for a backbone: competence (success_once, Wilson 95 % interval vs the floor) and wrapper\n"
                "parity (identity-wrapped vs unwrapped, same initial states); decision advance or exclude (exit 1).\n"
-               "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<file>, dp:<file>, external:<command>.");
+               "Backbones: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, dp (the task's committed\n"
+               "Diffusion Policy, configs/backbones/<task>.dp.asdp), mlp:<file>, dp:<file>, external:<command>.");
   gate0->add_option("--backbone", gate0_o.backbone, "Backbone")->capture_default_str();
   gate0->add_option("--task", gate0_o.task, "Task")->required();
   gate0->add_option("--profile", gate0_o.run.profile, "Simulator fidelity profile: maniskill or ideal (docs/sim.md)")->check(kProfile)

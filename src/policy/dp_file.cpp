@@ -156,10 +156,10 @@ DpPolicy::DpPolicy(std::shared_ptr<const DpWeights> weights, std::string sha256,
     throw std::invalid_argument("DpPolicy: weights do not match the architecture");
 }
 
-std::unique_ptr<DpPolicy> DpPolicy::from_file(const std::string& path) {
+std::unique_ptr<DpPolicy> DpPolicy::from_file(const std::string& path, std::string name) {
   const std::string bytes = weight_file::read(path, kMaxFileBytes, "weight file");
   auto w = std::make_shared<const DpWeights>(parse_dp(bytes, path));
-  return std::make_unique<DpPolicy>(std::move(w), sha256_hex(bytes), "dp:" + path);
+  return std::make_unique<DpPolicy>(std::move(w), sha256_hex(bytes), name.empty() ? "dp:" + path : std::move(name));
 }
 
 void DpPolicy::reset() {

@@ -26,7 +26,14 @@ std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const 
   return dir + "/" + std::string(sim::task_name(task)) + "." + std::string(backbone) + ".asmlp";
 }
 
-std::vector<std::string> builtin_backbones() { return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo", "ppo-delay-aware"}; }
+std::string dp_weights_path(sim::TaskId task, const std::string& backbones_dir) {
+  const std::string dir = backbones_dir.empty() ? default_backbones_dir() : backbones_dir;
+  return dir + "/" + std::string(sim::task_name(task)) + ".dp.asdp";
+}
+
+std::vector<std::string> builtin_backbones() {
+  return {"expert", "expert-delay-aware", "mlp", "mlp-delay-aware", "ppo", "ppo-delay-aware", "dp"};
+}
 
 namespace {
 std::string external_command(std::string_view backbone) {
@@ -72,10 +79,11 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
                                                                       : "ppo needs a network without an action history");
     return p;
   }
-  if (backbone.starts_with("dp:")) {  // a Diffusion Policy weight file (dp.hpp), named by its path
-    const std::string path(backbone.substr(3));
+  if (backbone == "dp" || backbone.starts_with("dp:")) {  // a Diffusion Policy (dp.hpp): the task's committed one, or a file
+    const bool builtin = backbone == "dp";
+    const std::string path = builtin ? dp_weights_path(task, options.backbones_dir) : std::string(backbone.substr(3));
     if (path.empty()) throw InputError("", "backbone", "dp: needs a weight file, e.g. dp:pick_cube.asdp");
-    auto p = DpPolicy::from_file(path);
+    auto p = DpPolicy::from_file(path, builtin ? "dp" : "");
     if (p->task() != task)
       throw InputError(path, "task", "weights are for " + std::string(sim::task_name(p->task())) + ", not " +
                                          std::string(sim::task_name(task)));
@@ -86,7 +94,7 @@ std::unique_ptr<Policy> make_policy(std::string_view backbone, sim::TaskId task,
   }
   throw InputError("", "backbone",
                    "unknown backbone '" + std::string(backbone) +
-                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, mlp:<path>, dp:<path>, external:<command>)");
+                       "' (valid: expert, expert-delay-aware, mlp, mlp-delay-aware, ppo, ppo-delay-aware, dp, mlp:<path>, dp:<path>, external:<command>)");
 }
 
 }  // namespace actionshift::policy

@@ -240,8 +240,8 @@ DpWeights load_dp(const std::string& path);
 class DpPolicy final : public Policy {
  public:
   DpPolicy(std::shared_ptr<const DpWeights> weights, std::string sha256, std::string name);
-  /// Load from a file (hash = SHA-256 of its bytes); name "dp:<path>".
-  static std::unique_ptr<DpPolicy> from_file(const std::string& path);
+  /// Load from a file (hash = SHA-256 of its bytes); name `name`, or "dp:<path>" when empty.
+  static std::unique_ptr<DpPolicy> from_file(const std::string& path, std::string name = "");
 
   void reset() override;
   Action act(const Eigen::Ref<const Eigen::VectorXd>& obs) override;

@@ -32,6 +32,10 @@ struct RegistryOptions {
 /// Weight file of a built-in MLP backbone for a task, e.g. "<dir>/pick_cube.mlp.asmlp".
 std::string mlp_weights_path(std::string_view backbone, sim::TaskId task, const std::string& backbones_dir = "");
 
+/// Weight file of the built-in Diffusion Policy backbone `dp` for a task: "<dir>/<task>.dp.asdp"
+/// (docs/backbones.md, "Diffusion Policy": committed once a candidate passes its adoption rule).
+std::string dp_weights_path(sim::TaskId task, const std::string& backbones_dir = "");
+
 /// Build a backbone by name for a task. Throws actionshift::InputError (field "backbone") for an
 /// unknown name, a missing or invalid weight file, or a weight file of another task; std::runtime_error
 /// if an external process cannot be started.
