@@ -12,8 +12,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 
 namespace actionshift::policy {
