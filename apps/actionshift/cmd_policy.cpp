@@ -151,7 +151,11 @@ int run_train_dp(const TrainDpCliOptions& o, std::ostream& out, std::ostream& er
                                {"final_loss", result.final_loss}};
     policy::save_dp(result.weights, o.out);
     write_file_atomic(curve_path, curve.str());
-    if (!t.checkpoint.empty()) std::filesystem::remove(t.checkpoint);  // the weight file supersedes it
+    if (!t.checkpoint.empty()) {  // the weight file supersedes it; failing to remove it loses nothing
+      std::error_code ec;
+      std::filesystem::remove(t.checkpoint, ec);
+      if (ec) err << "train dp: note: could not remove the checkpoint " << t.checkpoint << ": " << ec.message() << "\n";
+    }
     const std::string bytes = policy::serialize_dp(result.weights);
     err << "train dp: " << result.demo_successes << "/" << t.demos << " demos kept, " << result.windows << " windows; "
         << fmt(per_iteration, 3) << " s per iteration (batch " << t.batch_size << ")\n";
