@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""Writes docs/results/brittleness.md: per task and backbone, clean success (Gate 0's unwrapped runs, one
+"""Writes docs/results/brittleness.md: per task, backbone and split, clean success (Gate 0's unwrapped runs, one
 verdict file per seed), hidden with no adaptation, and restored by each adapter label, beside the paper's
-numbers. Layout only: every rate, interval, difference and verdict is from `actionshift compare` (the
-cells and the pairs of scripts/brittleness.pairs) or from a Gate 0 verdict file; the paper's numbers from
-compare's paper fields or, for the Diffusion Policy scalars, configs/paper/numbers.json by id.
+numbers (its frozen PPO's for the expert, MLP and PPO rows, its Diffusion Policy's for the `dp` rows). Layout
+only: every rate, interval, difference and verdict is from `actionshift compare` (the cells and the pairs of
+scripts/brittleness.pairs) or from a Gate 0 verdict file; the paper's numbers from compare's paper fields or,
+for the clean rates and the Diffusion Policy scalars, configs/paper/numbers.json by id; the Diffusion Policy's
+inference cost from RESULTS_DIR/dp_cost.json (scripts/pages/dp_cost.py) when it exists.
 usage: scripts/brittleness_report.py COMPARE_JSON RESULTS_DIR [--commit C --command CMD --wall S --cores N --cpu TIMES]"""
 import glob
 import json
@@ -15,13 +17,132 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import findings, fmt, load_comparison, paper, provenance, table  # noqa: E402
 from pages.rest_util import cpu_text, commit_of, parser, probe_rule, rel, scalar  # noqa: E402
 
-BACKBONES = [("expert", "scripted"), ("mlp", "imitation (DAgger MLP)"), ("ppo", "RL (PPO)")]
-ORDER = ["no_adapt", "oracle", "entropy_probes", "entropy_probes{calibrated}", "dualabi", "dualabi{calibrated}",
+BACKBONES = [("expert", "scripted"), ("mlp", "imitation (DAgger MLP)"), ("dp", "imitation (Diffusion Policy)"),
+             ("ppo", "RL (PPO)")]
+SPLITS = ["reference_seen", "reference_unseen_composition"]
+ORDER = ["no_adapt", "oracle", "exact_belief", "entropy_probes", "entropy_probes{calibrated}", "dualabi", "dualabi{calibrated}",
          "grammar_belief"]
 DP_IDS = ["s5.8.pick_cube.diffusion_policy.clean_success", "s5.8.push_cube.diffusion_policy.clean_success",
           "s5.8.diffusion_policy.no_adapt", "abstract.no_adapt.success_once_floor_min", "abstract.no_adapt.success_once_floor_max",
           "s5.8.diffusion_policy.restored_success_min", "s5.8.diffusion_policy.restored_success_max",
           "s5.8.diffusion_policy.dualabi.probe_steps_seen"]
+
+
+def job_summaries(results, jobs):
+    """{job id: its `<id>.summary.json`} for the jobs that have one."""
+    out = {}
+    for j in jobs:
+        path = os.path.join(results, j + ".summary.json")
+        if os.path.exists(path):
+            with open(path) as f:
+                out[j] = json.load(f)
+    return out
+
+
+def jobs_wall_per_step(C, summaries, task, dp):
+    """(seconds, control steps) of the task's jobs with (dp) or without the `dp` backbone, from their summaries'
+    `wall_time_s` and `mean_steps` x `episodes_run` (each job's own run; a job resumed across runs counts its last)."""
+    sec = steps = 0.0
+    for c in C.cells_where(task=task):
+        if (c["backbone"] == "dp") != dp:
+            continue
+        for j in c["jobs"]:
+            v = summaries.get(j)
+            if v and v.get("wall_time_s") is not None:
+                sec += v["wall_time_s"]
+                steps += v["mean_steps"] * v["episodes_run"]
+    return sec, steps
+
+
+def duration(seconds):
+    """`42 s`, `12.5 min` or `3.20 h`."""
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.1f} min"
+    return f"{seconds / 3600:.2f} h"
+
+
+def threads_of(command):
+    """THREADS=N of the recorded command, or '?'."""
+    m = re.search(r"THREADS=(\d+)", command or "")
+    return m.group(1) if m else "?"
+
+
+def clean_paper_id(backbone, task):
+    """The paper's clean rate for a backbone's row: its Diffusion Policy's (§5.8) for `dp`, its frozen PPO's (Table 1)."""
+    return f"s5.8.{task}.diffusion_policy.clean_success" if backbone == "dp" else f"table1.{task}.clean_success"
+
+
+def horizons(cell, spec_of):
+    """The control steps per episode of a cell's jobs (a job spec names its horizon only when it is not the task's)."""
+    hs = sorted({str(spec_of[j].get("horizon", "task's")) for j in cell["jobs"] if j in spec_of})
+    return ", ".join(hs) or fmt.DASH
+
+
+def paper_backbone(cell):
+    e = paper.cell_entry(cell)
+    return (e or {}).get("paper_backbone", fmt.DASH)
+
+
+def dp_probe_status(cell):
+    """The paper's 'DualABI needs 0.0 probe steps on seen' for our `dp`: reproduced when our mean prints as 0.0 (below
+    0.05 steps per episode), contradicted otherwise, untestable when the cell was not run. Rule written before any
+    Diffusion Policy ran."""
+    if not cell:
+        return "untestable", "the cell was not run here"
+    m = cell["mean_probe_steps"]
+    if m < 0.05:
+        return "reproduced", f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes"
+    return "contradicted", f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes, against the paper's 0.0"
+
+
+def dp_cost_section(path, C, summaries, threads):
+    """The Diffusion Policy's inference cost against the simulator step it drives, from dp_cost.json."""
+    if not os.path.exists(path):
+        return ["No Diffusion Policy ran here, so its inference cost was not measured on this page (docs/backbones.md"
+                " has the benchmark's figures for both networks).\n"]
+    with open(path) as f:
+        d = json.load(f)
+    load = d.get("load_avg")
+    out = [f"Measured by `scripts/brittleness` after its runs ({d['bench']}), {d.get('date', '?')}, load average "
+           f"{', '.join(f'{x:.2f}' for x in load) if load else '?'} on {d.get('num_cpus', '?')} CPUs: the policy's "
+           "figures are CPU time on one thread (random weights of the same shape and sampler), the simulator's one "
+           "thread's control steps per second (`bench env`, a scripted grasp with contact).\n"]
+    rows = []
+    for t in d["tasks"]:
+        rows.append([t["task"], f"`{t['weights']}`", "/".join(str(x) for x in t["down_dims"]), fmt.thousands(t["parameters"]),
+                     t["sampler"], f"{t['chunk_ms']:.1f}", f"{t['control_step_ms']:.2f}", f"{t['sim_step_ms']:.3f}",
+                     f"{t['ratio']:.0f}x"])
+    out.append(table.markdown(["task", "weights", "U-Net", "parameters", "sampler", "one chunk [ms]",
+                               "per control step [ms] (a chunk per " + str(d["tasks"][0]["act_horizon"]) + " steps)",
+                               "simulator step [ms]", "policy / simulator"], rows,
+                              ["l", "l", "l", "r", "l", "r", "r", "r", "r"]))
+    out.append("")
+    for t in d["tasks"]:
+        if t["ratio"] <= 1.0:
+            out.append(f"On {t['task']} a Diffusion Policy step costs less than the simulator step it drives.\n")
+            continue
+        out.append(
+            f"On {t['task']} a Diffusion Policy control step costs **{t['ratio']:.0f} times** the simulator step it drives, "
+            "so it does not meet the bar of costing less. The factor carries over to any evaluation: an episode with this "
+            f"backbone costs about {t['ratio'] + 1:.0f} times one with a policy of negligible cost (the MLP and PPO "
+            "backbones cost microseconds per step), because the runner spends its time in the sampler's U-Net passes; "
+            "a tournament of the same episodes would take that much longer on the same cores. The paper's Diffusion "
+            "Policy ran on a GPU.\n")
+        ds, dn = jobs_wall_per_step(C, summaries, t["task"], True)
+        os_, on = jobs_wall_per_step(C, summaries, t["task"], False)
+        if dn:
+            text = (f"In this page's own runs ({threads} thread(s) per job; the jobs' `wall_time_s` and steps from their"
+                    f" summaries) the `dp` jobs of {t['task']} took {duration(ds)} for {fmt.thousands(int(dn))} control steps"
+                    f" ({1000 * ds / dn:.2f} ms per step), of which the benchmark's figure accounts for about"
+                    f" {duration(dn * t['control_step_ms'] / 1000)}")
+            if on:
+                text += (f"; the other backbones' jobs took {duration(os_)} for {fmt.thousands(int(on))} steps"
+                         f" ({1000 * os_ / on:.3f} ms per step, adapters and simulation included)")
+            out.append(text + ".\n")
+    out.append("")
+    return out
 
 
 def main():
@@ -32,7 +153,9 @@ def main():
     C = load_comparison(a.compare)
     numbers = paper.load_numbers()
     res = rel(a.results)
-    specs = provenance.job_specs([a.results], C.jobs())
+    summaries = job_summaries(a.results, C.jobs())
+    spec_of = {j: v["job"] for j, v in summaries.items()}
+    specs = list(spec_of.values())
     clean = {}  # (backbone, task) -> [(seed, cell of the verdict file)]
     for f in sorted(glob.glob(os.path.join(a.results, "clean", "*.json"))):
         with open(f) as fh:
@@ -53,11 +176,14 @@ def main():
     w("The paper's claim (§5.8): brittleness is interface-semantic, not paradigm-specific. A frozen imitation policy\n"
       "(Diffusion Policy) collapses under the same hidden contracts that zero the frozen PPO policy, and the same\n"
       "policy-agnostic adapters restore it to its own oracle ceiling. Here each backbone runs clean, behind the hidden\n"
-      "contracts of `reference_seen` with no adaptation, and through the same adapters: the oracle, entropy probing and\n"
-      "DualABI over the `reference9` pool, each with the paper's probe rule (the bare name) and the project's\n"
-      "`{calibrated}` rule (docs/adapters.md), and the pool-free grammar belief. What each label ran is read from the\n"
-      "label (column `what ran`). The paper column is the paper's frozen PPO (Table 2, Table 5) for the bare labels;\n"
-      "a `{...}` label has no paper number.\n")
+      "contracts of `reference_seen` and `reference_unseen_composition` with no adaptation, and through the same\n"
+      "adapters: the oracle, the exact pool belief, entropy probing and DualABI over the `reference9` pool (the probing\n"
+      "ones with the paper's probe rule, the bare name, and the project's `{calibrated}` rule, docs/adapters.md), and\n"
+      "the pool-free grammar belief. What each label ran is read from the label (column `what ran`). The Diffusion\n"
+      "Policy (`dp`) runs at horizon 100, as the reference evaluates it; the others at the task's (50 control steps\n"
+      "here). The paper column holds the paper's number for the row's paradigm, named in the next column: its frozen\n"
+      "PPO (Table 2, Table 5) beside `expert`, `mlp` and `ppo`, its Diffusion Policy (the reference implementation's\n"
+      "imitation report, horizon 100) beside `dp`; a `{...}` label has no paper number.\n")
     for task in C.values("task"):
         w(f"## {task}\n")
         rows = []
@@ -65,48 +191,68 @@ def main():
             cells = C.cells_where(task=task, backbone=bb)
             if not cells and (bb, task) not in clean:
                 continue
+            ce = numbers.by_id(clean_paper_id(bb, task))
             for seed, v in clean.get((bb, task), []):
-                rows.append([f"`{bb}`", paradigm, "clean (Gate 0, unwrapped)", f"seed {seed}",
-                             fmt.rate(v["competence"]["interval"]), fmt.DASH, fmt.DASH, fmt.DASH,
-                             paper.entry_value(numbers.by_id(f"table1.{task}.clean_success"))])
-            labels = [m for m in ORDER if C.cell(task, "reference_seen", m, bb)]
-            labels += [m for m in C.values("method", cells) if m not in labels]
-            for m in labels:
-                c = C.cell(task, "reference_seen", m, bb)
-                if not c:
-                    continue
-                rows.append([f"`{bb}`", paradigm, f"`{m}`", probe_rule(m) if probe_rule(m) != m else fmt.DASH, fmt.cell_rate(c), fmt.per_seed(c),
-                             fmt.probe_steps(c), fmt.safety(c), paper.cell_column(c)])
-        w(table.markdown(["backbone", "paradigm", "label", "what ran", "success (Wilson 95 %)", "per seed",
-                          "probe steps", "flagged episodes", "paper (frozen PPO)"], rows,
-                         ["l", "l", "l", "l", "l", "l", "r", "l", "l"]))
+                rows.append([f"`{bb}`", paradigm, fmt.DASH, str(v.get("horizon", "task's")), "clean (Gate 0, unwrapped)",
+                             f"seed {seed}", fmt.rate(v["competence"]["interval"]), fmt.DASH, fmt.DASH, fmt.DASH,
+                             paper.entry_value(ce), (ce or {}).get("paper_backbone", fmt.DASH)])
+            for split in SPLITS + [x for x in C.values("split", cells) if x not in SPLITS]:
+                labels = [m for m in ORDER if C.cell(task, split, m, bb)]
+                labels += [m for m in C.values("method", C.cells_where(task=task, split=split, backbone=bb))
+                           if m not in labels]
+                for m in labels:
+                    c = C.cell(task, split, m, bb)
+                    rows.append([f"`{bb}`", paradigm, split.replace("reference_", ""), horizons(c, spec_of), f"`{m}`",
+                                 probe_rule(m) if probe_rule(m) != m else fmt.DASH, fmt.cell_rate(c), fmt.per_seed(c),
+                                 fmt.probe_steps(c), fmt.safety(c), paper.cell_column(c), paper_backbone(c)])
+        w(table.markdown(["backbone", "paradigm", "split", "horizon", "label", "what ran", "success (Wilson 95 %)",
+                          "per seed", "probe steps", "flagged episodes", "paper", "paper's backbone"], rows,
+                         ["l", "l", "l", "r", "l", "l", "l", "l", "r", "l", "l", "l"]))
         w("")
     w("## Paired differences\n")
-    w("Every pair of `scripts/brittleness.pairs` in every backbone that ran both labels (candidate − baseline over the same"
-      " episodes), with the promotion gate's verdict and the paper's difference where the paper gives one.\n")
+    w("Every pair of `scripts/brittleness.pairs` in every backbone and split that ran both labels (candidate − baseline"
+      " over the same episodes), with the promotion gate's verdict and the paper's difference where the paper gives one.\n")
     rows = []
     for cmp in C.comparisons:
         v, rule, _ = fmt.promotion(cmp)
-        rows.append([cmp["task"], f"`{cmp['backbone']}`", f"`{cmp['candidate']}` − `{cmp['baseline']}`", fmt.cmp_rates(cmp),
-                     fmt.cmp_diff(cmp, mark=True), fmt.per_seed_diff(cmp), paper.cmp_column(cmp), f"{v} ({rule})"])
-    w(table.markdown(["task", "backbone", "pair", "success: candidate / baseline", "difference [95 %]", "per seed",
-                      "paper", "promotion"], rows))
+        rows.append([cmp["task"], cmp["split"].replace("reference_", ""), f"`{cmp['backbone']}`",
+                     f"`{cmp['candidate']}` − `{cmp['baseline']}`", fmt.cmp_rates(cmp), fmt.cmp_diff(cmp, mark=True),
+                     fmt.per_seed_diff(cmp), paper.cmp_column(cmp), f"{v} ({rule})"])
+    w(table.markdown(["task", "split", "backbone", "pair", "success: candidate / baseline", "difference [95 %]",
+                      "per seed", "paper", "promotion"], rows))
     w("")
     w("## The paper's findings\n")
     w("Status from compare's fields (scripts/pages/findings.py): a finding whose paper difference is significant is"
-      " reproduced only when ours excludes 0 with the same sign (compare's `sign_agreement`).\n")
-    items = [(f"the hidden contract collapses `{c['backbone']}` and the oracle restores it ({c['task']})", c)
+      " reproduced only when ours excludes 0 with the same sign (compare's `sign_agreement`). For `dp` the paper's"
+      " differences are those of its Diffusion Policy's printed cells (their notes say how).\n")
+    items = [(f"the hidden contract collapses `{c['backbone']}` and the oracle restores it ({c['task']} / {c['split']})", c)
              for c in C.comparisons_where(candidate="oracle", baseline="no_adapt")]
     items += [(f"{findings.describe(c)} (`{c['backbone']}`)", c) for c in C.comparisons
               if c.get("paper") and c["candidate"] != "oracle"]
     w(findings.findings_table(items) if items else "No pair with a paper difference was run.\n")
     w("")
-    w("## The paper's Diffusion Policy numbers (§5.8)\n")
-    w("The paper's imitation backbone is a Diffusion Policy (ours: the DAgger MLP). From configs/paper/numbers.json by id:\n")
+    w("## The Diffusion Policy (§5.8)\n")
+    w("The paper's imitation backbone is a Diffusion Policy; ours are the DAgger MLP (`mlp`) and, where a weight file"
+      " is adopted (docs/backbones.md), a Diffusion Policy trained here from the scripted expert's demonstrations"
+      " (`dp`). Its clean rate, collapse and restoration are the `dp` rows and findings above. DualABI's probe"
+      " steps on the seen contracts (the paper: 0.0), by the rule of scripts/brittleness_report.py `dp_probe_status`:\n")
+    rows = []
+    for task in C.values("task"):
+        c = C.cell(task, "reference_seen", "dualabi", "dp")
+        if not c and ("dp", task) not in clean:
+            continue
+        st, why = dp_probe_status(c)
+        rows.append([task, fmt.probe_steps(c), "0.00 (§5.8)", f"**{st}**", why])
+    w(table.markdown(["task", "ours: `dualabi` probe steps (seen)", "paper", "status", "reason"], rows)
+      if rows else "No `dp` backbone ran here: no Diffusion Policy weight file is adopted yet (docs/backbones.md).\n")
+    w("")
+    w("The paper's scalars (configs/paper/numbers.json by id):\n")
     rows = [[f"`{i}`", (numbers.by_id(i) or {}).get("quantity", fmt.DASH), scalar(numbers, i),
              (numbers.by_id(i) or {}).get("note", "")] for i in DP_IDS]
     w(table.markdown(["id", "quantity", "value (source)", "note"], rows))
     w("")
+    w("### Inference cost\n")
+    out.extend(dp_cost_section(os.path.join(a.results, "dp_cost.json"), C, summaries, threads_of(a.command)))
     w("## Backbone identities\n")
     sha = sorted({(s["backbone"]["name"], s["task"], s["backbone"]["sha256"]) for s in specs})
     w(table.markdown(["backbone", "task", "sha256"], [[f"`{b}`", t, f"`{h}`"] for b, t, h in sha]))

@@ -15,13 +15,35 @@ for page in $PAGES; do
   rm -rf "${D:?}/$page"; mkdir -p "$D/$page"
   case $page in
   brittleness)
+    # expert and a tiny Diffusion Policy (the scaled U-Net's shape, so the cost benchmark has its row; one training
+    # iteration: the page's layout, not its competence), both splits, every label; dp at horizon 100 as the script runs it
     mkdir -p "$D/$page/results/clean"
-    "$AS" gate0 --backbone expert --task pick_cube --episodes "$N" --seed "$S" --threads 1 --quiet \
-        --out "$D/$page/results/clean/expert.pick_cube.$S.json" > /dev/null || true
-    for m in no_adapt oracle grammar_belief; do run --task pick_cube --split reference_seen --method "$m" --out "$D/$page/results"; done
-    for m in entropy_probes 'entropy_probes{calibrated}' dualabi 'dualabi{calibrated}'; do
-      run --task pick_cube --split reference_seen --method "$m" --pool reference9 --out "$D/$page/results"
-    done ;;
+    bdir=$(mktemp -d)
+    "$AS" train dp --task pick_cube --demos 2 --iterations 1 --down-dims 32,64,128 --seed 1 --threads 1 \
+        --out "$bdir/pick_cube.dp.asdp" > /dev/null
+    for b in expert dp; do
+      h=(); [ "$b" = dp ] && h=(--horizon 100)
+      ACTIONSHIFT_BACKBONES_DIR="$bdir" "$AS" gate0 --backbone "$b" --task pick_cube --episodes "$N" --seed "$S" "${h[@]}" \
+          --threads 1 --quiet --out "$D/$page/results/clean/$b.pick_cube.$S.json" > /dev/null || true
+      for split in reference_seen reference_unseen_composition; do
+        for m in no_adapt oracle grammar_belief; do
+          ACTIONSHIFT_BACKBONES_DIR="$bdir" run --task pick_cube --split "$split" --method "$m" --backbone "$b" "${h[@]}" --out "$D/$page/results"
+        done
+        for m in exact_belief entropy_probes 'entropy_probes{calibrated}' dualabi 'dualabi{calibrated}'; do
+          ACTIONSHIFT_BACKBONES_DIR="$bdir" run --task pick_cube --split "$split" --method "$m" --pool reference9 --backbone "$b" "${h[@]}" \
+              --out "$D/$page/results"
+        done
+      done
+    done
+    bench="$(dirname "$AS")/../../tests/bench/actionshift_dp_bench"
+    "$bench" --benchmark_filter='BM_DpControlStep/1|BM_DpChunk/1' --benchmark_repetitions=2 --benchmark_report_aggregates_only=true \
+        --benchmark_format=json > "$bdir/dp_bench.json"
+    "$AS" bench env --task pick_cube --threads 1 --steps 2000 --json > "$bdir/env_bench.jsonl"
+    (cd "$bdir" && python3 "$OLDPWD/scripts/pages/dp_cost.py" --command "actionshift_dp_bench \
+        --benchmark_filter='BM_DpControlStep/1|BM_DpChunk/1' --benchmark_repetitions=2; actionshift bench env --steps 2000" \
+        dp_bench.json env_bench.jsonl pick_cube.dp.asdp) \
+        > "$D/$page/results/dp_cost.json"
+    rm -rf "$bdir" ;;
   backbone_variance)
     # three backbones of push_cube (the committed PPO and the two replicas), two seeds, every method of the pairs
     for b in ppo mlp:configs/backbones/replicas/push_cube.ppo.seed20260801.asmlp mlp:configs/backbones/replicas/push_cube.ppo.seed20260802.asmlp; do

@@ -26,4 +26,7 @@ if(Python3_Interpreter_FOUND)
   # the wall-time clause of every page header: jobs an earlier invocation ran are named, not counted as this run's time
   add_test(NAME pages.wall_text COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/wall_text_test.py)
   set_tests_properties(pages.wall_text PROPERTIES LABELS pages TIMEOUT 60)
+  # the Diffusion Policy's cost beside the simulator step (the brittleness page): the right benchmark row, one-line refusals
+  add_test(NAME pages.dp_cost COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/dp_cost_test.py)
+  set_tests_properties(pages.dp_cost PROPERTIES LABELS pages TIMEOUT 60)
 endif()
