@@ -167,7 +167,7 @@ def main():
         "scripts/brittleness_report.py", a.command or f"scripts/brittleness {res}", commit_of(a), [res],
         provenance.spec_values(specs, "profile"), C.seeds(), C.episodes(), jobs=len(C.jobs()),
         episodes_per_seed=C.episodes_per_seed(), wall=a.wall, cores=a.cores, paper_source=C.paper_source(),
-        bootstrap=C.bootstrap(),
+        bootstrap=C.bootstrap(), reused=a.reused,
         extra=[f"CPU: {cpu_text(a.cpu)[2:] or 'not measured'}.",
                "Clean: Gate 0's unwrapped run (`actionshift gate0 --seed S`, one verdict file per seed in "
                f"`{res}/clean/`), shown per seed with the Wilson interval the verdict file holds (compare does not read "
