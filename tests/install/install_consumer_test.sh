@@ -10,6 +10,9 @@ cmake --install "$BUILD" --prefix "$WORK/prefix" > "$WORK/install.log"
 cmake -S "$CONSUMER" -B "$WORK/build" -DCMAKE_PREFIX_PATH="$WORK/prefix" -DCMAKE_BUILD_TYPE=Release > "$WORK/configure.log" 2>&1 \
   || { cat "$WORK/configure.log"; exit 1; }
 cmake --build "$WORK/build" > "$WORK/build.log" 2>&1 || { cat "$WORK/build.log"; exit 1; }
+# all_headers (built above) included every installed header together; none of the internal/ ones is installed
+echo "installed headers: $(find "$WORK/prefix/include/actionshift" -name '*.hpp' | wc -l), compiled together"
+[ ! -e "$WORK/prefix/include/actionshift/core/workers.hpp" ] || { echo "an internal header was installed"; exit 1; }
 out=$("$WORK/build/consumer")
 echo "$out"
 grep -q "identity 6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa" <<<"$out"

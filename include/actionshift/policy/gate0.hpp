@@ -14,7 +14,7 @@
 #include "actionshift/policy/policy.hpp"
 #include "actionshift/policy/rollout.hpp"
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
 #include <functional>

@@ -22,7 +22,6 @@
 /// are stored by environment index; a minibatch gradient is the ordered sum of a fixed number of
 /// chunk gradients, computed in parallel.
 
-#include "actionshift/core/workers.hpp"
 #include "actionshift/policy/mlp.hpp"
 #include "actionshift/sim/env.hpp"
 
@@ -33,6 +32,10 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+namespace actionshift {
+class WorkerPool;  // the project's worker pool (internal: the library's own training loop passes it)
+}  // namespace actionshift
 
 namespace actionshift::policy {
 
