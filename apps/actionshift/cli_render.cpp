@@ -6,6 +6,9 @@
 
 namespace actionshift::cli {
 
+// a GIF frame's time: 1/100 s to 10 s (render and montage)
+const auto kGifDelay = CLI::Range(1, 1000);
+
 void register_render_commands(CLI::App& app, CliContext& ctx) {
   // ---- render | montage | report (render layer)
   auto& render_o = ctx.make<cli::RenderOptions>();
@@ -17,7 +20,7 @@ void register_render_commands(CLI::App& app, CliContext& ctx) {
       "(reset / probe / act) and success. Episode E of contract I is the one of block E (the job's episodes\n"
       "E * contracts ... E * contracts + contracts - 1, in a seeded order) that runs contract I.");
   add_job_options(ctx, render, render_o.job, /*required=*/true);
-  render->add_option("--step-timeout", render_o.step_timeout_s, "Seconds an external:<command> backbone may take per step (as for run)")
+  render->add_option("--step-timeout", render_o.render.episode.external.step_timeout_s, "Seconds an external:<command> backbone may take per step (as for run)")
       ->check(CLI::Range(0.001, 86400.0) & kNotNan)
       ->capture_default_str();
   render->add_option("--contract", render_o.contract, "Contract index in the split")->capture_default_str();
@@ -28,10 +31,10 @@ void register_render_commands(CLI::App& app, CliContext& ctx) {
       ->capture_default_str();
   render->add_option("--size", render_o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
   render->add_option("--frame", render_o.frame, "PNG only: the state after this many steps (-1: the last)")->capture_default_str();
-  render->add_option("--delay", render_o.delay_cs, "GIF: hundredths of a second per frame")->capture_default_str();
-  render->add_flag("--clean", render_o.clean, "Same episode seed with the identity contract (the clean reference panel)");
-  render->add_option("--label", render_o.label, "Overlay title (default: the method, or clean)");
-  render->add_flag("--no-overlay", render_o.no_overlay, "No overlay");
+  render->add_option("--delay", render_o.delay_cs, "GIF: hundredths of a second per frame")->check(kGifDelay)->capture_default_str();
+  render->add_flag("--clean", render_o.render.clean, "Same episode seed with the identity contract (the clean reference panel)");
+  render->add_option("--label", render_o.render.label, "Overlay title (default: the method, or clean)");
+  render->add_flag("--no-overlay{false}", render_o.render.overlay, "No overlay");
   render->add_option("--out", render_o.out, "Output FILE.gif or FILE.png")->required();
   render->callback([&] { ctx.action = [&] { return cli::run_render(render_o); }; });
 
@@ -42,7 +45,7 @@ void register_render_commands(CLI::App& app, CliContext& ctx) {
   montage->add_option("inputs", montage_o.inputs, "Input GIF files, left to right")->required();
   montage->add_option("--out", montage_o.out, "Output FILE.gif or FILE.png")->required();
   montage->add_option("--frame", montage_o.frame, "PNG only: frame index (-1: the last)")->capture_default_str();
-  montage->add_option("--delay", montage_o.delay_cs, "GIF: hundredths of a second per frame")->capture_default_str();
+  montage->add_option("--delay", montage_o.delay_cs, "GIF: hundredths of a second per frame")->check(kGifDelay)->capture_default_str();
   montage->callback([&] { ctx.action = [&] { return cli::run_montage(montage_o); }; });
 
   auto& report_o = ctx.make<cli::ReportOptions>();

@@ -81,18 +81,13 @@ void write_frames(const std::string& out, Format f, std::vector<render::Image> f
 int run_render(const RenderOptions& o) {
   try {
     const Format format = check_output(o.out);
-    if (o.delay_cs < 1 || o.delay_cs > 1000) throw InputError("command line", "--delay", "must be in 1..1000");
     const auto [w, h] = parse_size(o.size);
     eval::JobSpec job;
-    render::EpisodeRenderOptions ro;
-    ro.episode.external.step_timeout_s = o.step_timeout_s;
+    render::EpisodeRenderOptions ro = o.render;
     resolve_cli_job(o.job, job, ro.episode);
     ro.width = w;
     ro.height = h;
     ro.camera = render::parse_camera(o.camera, sim::parse_task(job.task));
-    ro.overlay = !o.no_overlay;
-    ro.label = o.label;
-    ro.clean = o.clean;
     if (o.contract < 0 || o.contract >= job.split.contracts)
       throw InputError("command line", "--contract", std::to_string(o.contract) + " is outside the split's " +
                                                          std::to_string(job.split.contracts) + " contracts");
@@ -111,7 +106,7 @@ int run_render(const RenderOptions& o) {
     // the outcome, as the runner's record of this episode (a `--clean` render is not a runner record)
     nlohmann::json line = eval::to_json(r.record);
     line["rendered"] = o.out;
-    line["clean"] = o.clean;
+    line["clean"] = ro.clean;
     std::cout << line.dump() << "\n";
     return kOk;
   } catch (const std::exception& e) {
@@ -124,7 +119,6 @@ int run_montage(const MontageOptions& o) {
   try {
     const Format format = check_output(o.out);
     if (o.inputs.empty()) throw InputError("command line", "inputs", "no GIF to place side by side");
-    if (o.delay_cs < 1 || o.delay_cs > 1000) throw InputError("command line", "--delay", "must be in 1..1000");
     // every panel is decoded whole before the montage: bounded, as its GIFs are (8192 px a side)
     if (o.inputs.size() > 16) throw InputError("command line", "inputs", "at most 16 GIFs side by side (got " + std::to_string(o.inputs.size()) + ")");
     std::vector<std::vector<render::Image>> panels;

@@ -4,6 +4,8 @@
 
 #include "cmd_run.hpp"
 
+#include "actionshift/render/episode.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -16,16 +18,15 @@ namespace actionshift::cli {
 // --profile, --obs-noise, --calibration, --robot/--package, --policy-files) and --step-timeout.
 struct RenderOptions {
   CliJobOptions job;                // the job, resolved exactly as `run` resolves it
-  double step_timeout_s{10.0};      // --step-timeout S: external policy request/reply bound
+  // --clean, --label, --no-overlay and --step-timeout (render.episode.external.step_timeout_s) bind
+  // straight into the library's settings; the image size and camera are parsed into it by run_render
+  render::EpisodeRenderOptions render;
   std::int64_t contract{0};         // --contract I: contract index in the split
   std::int64_t episode{0};          // --episode E: the contract's E-th episode (job episode E * contracts + I)
   std::string camera{"default"};    // --camera
   std::string size{"320x240"};      // --size WxH
   int frame{-1};                    // --frame K (PNG only): the state after K steps; -1: the last
-  bool clean{false};                // --clean: identity contract, same episode seed
-  std::string label;                // --label: overlay title (default: the method, or "clean")
-  bool no_overlay{false};           // --no-overlay
-  int delay_cs{10};                 // --delay: GIF frame time in 1/100 s
+  int delay_cs{10};                 // --delay: GIF frame time in 1/100 s (1..1000, checked by CLI11)
   std::string out;                  // --out FILE.gif|FILE.png
 };
 int run_render(const RenderOptions& o);
@@ -36,7 +37,7 @@ struct MontageOptions {
   std::vector<std::string> inputs;
   std::string out;
   int frame{-1};
-  int delay_cs{10};
+  int delay_cs{10};  // 1..1000, checked by CLI11
 };
 int run_montage(const MontageOptions& o);
 

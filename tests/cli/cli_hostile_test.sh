@@ -297,7 +297,10 @@ run "$AS" train ppo --task pick_cube --target-kl nan --out "$TMP/kl.asmlp"
 expect_rc 2 "target-kl nan"
 run "$AS" montage "$TMP/huge.gif" --out "$TMP/m.gif" --delay 0
 expect_rc 2 "montage delay 0"
-expect_err "--delay: must be in 1..1000" "montage delay 0"
+expect_err "--delay: Value 0 not in range 1 to 1000" "montage delay 0"
+run "$AS" render --task pick_cube --split reference_seen --method no_adapt --episodes 1 --out "$TMP/r.gif" --delay 1001
+expect_rc 2 "render delay 1001"
+expect_err "--delay: Value 1001 not in range 1 to 1000" "render delay 1001"
 
 # ---- amplification: thread counts and calibration walks are bounded (10,000 threads made 7,939 OS threads)
 run "$AS" run --task pick_cube --split reference_seen --method oracle --threads 10000 --out "$TMP/th" --progress off

@@ -74,6 +74,22 @@ PY
 run "$AS" render "${JOB[@]}" --method oracle --frame 0 --camera top --no-overlay --size 64x48 --out "$TMP/ep.png"
 expect_rc 0 "render png"
 [ "$(head -c 4 "$TMP/ep.png" | tail -c 3)" = "PNG" ] && ok || bad "not a PNG"
+# --no-overlay, --clean and --label reach the renderer's settings (bound straight into them)
+run "$AS" render "${JOB[@]}" --method oracle --frame 0 --camera top --size 64x48 --out "$TMP/ov.png"
+expect_rc 0 "render png with the overlay"
+cmp -s "$TMP/ep.png" "$TMP/ov.png" && bad "--no-overlay drew the same image as the overlay" || ok
+printf '%s\n' "$OUT" > "$TMP/overlay.json"
+run "$AS" render "${JOB[@]}" --method no_adapt --clean --label reference --frame 0 --camera top --size 64x48 --out "$TMP/clean.png"
+expect_rc 0 "render --clean"
+printf '%s\n' "$OUT" > "$TMP/clean.json"
+python3 - "$TMP/overlay.json" "$TMP/clean.json" <<'PY' && ok || bad "--clean did not run the identity contract, or a render without it says clean"
+import json, sys
+plain, clean = (json.loads(open(f).read()) for f in sys.argv[1:3])
+assert plain["clean"] is False and clean["clean"] is True, (plain["clean"], clean["clean"])
+# the identity contract's sha256 (tests/install: the consumer prints it)
+assert clean["contract_sha256"] == "6b38e10f94c37daf6ec3027f9fade885c611bbf710b732cc6f61ed134efb1eaa", clean
+assert plain["contract_sha256"] != clean["contract_sha256"]
+PY
 
 # every job option of run reaches render: an external policy with --policy-files renders its run's job
 cp "$SRC/docs/examples/external_policy.py" "$TMP/policy.py"
