@@ -108,6 +108,18 @@ TEST(PpoTrain, DeterministicWhateverTheThreadsAndLoadsAsABackbone) {
   EXPECT_EQ(pol.clone()->name(), "ppo");
 }
 
+// The tiny runs' weight files, byte for byte (SHA-256), for the plain and the delay-aware rollout: a change
+// to the rollout loop (its environments, seeds, reset rule or order of work) that is meant to keep every
+// committed backbone reproducible must keep these. Regenerate only for an intended change of training.
+TEST(PpoTrain, TinyRunsKeepTheirBytes) {
+  const std::string plain = sha256_hex(policy::serialize_mlp(policy::train_ppo(tiny(2), {{"seed", 20260718}}).actor));
+  auto o = tiny(2);
+  o.delay_aware = true;
+  const std::string delay_aware = sha256_hex(policy::serialize_mlp(policy::train_ppo(o, {}).actor));
+  EXPECT_EQ(plain, "11236afa054278a0b4612ed34091a0ad58d95fa7e32ca906c2708cbe9a54e771");
+  EXPECT_EQ(delay_aware, "7128055463bd08a530777d5b19d8abae4949986c6bef8fc11ba724c25d80c46e");
+}
+
 TEST(PpoTrain, DelayAwareSeesTheExecutedActionHistoryAndIsDeterministic) {
   auto o = tiny(1);
   o.delay_aware = true;
