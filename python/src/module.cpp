@@ -12,7 +12,6 @@
 #include "actionshift/core/hash.hpp"
 #include "actionshift/core/json_input.hpp"
 #include "actionshift/core/manifest.hpp"
-#include "actionshift/core/workers.hpp"
 #include "actionshift/core/transforms.hpp"
 #include "actionshift/core/validate.hpp"
 #include "actionshift/data/builtin_manifests.hpp"
@@ -38,6 +37,7 @@
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/vec_env.hpp"
 #include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/scene.hpp"
 #include "actionshift/sim/task.hpp"
@@ -648,12 +648,10 @@ class PyVecEnv {
     } else {
       contracts.assign(static_cast<std::size_t>(num_envs), pick_contract(contract, split, index));
     }
-    for (const auto& c : contracts) envs_.emplace_back(ref_.model, c, rot);
     seeds_.assign(static_cast<std::size_t>(num_envs), 0);
-    if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
-    pool_ = std::make_unique<WorkerPool>(std::min<unsigned>(threads, static_cast<unsigned>(num_envs)));
+    vec_ = std::make_unique<sim::VecEnv>(ref_.model, contracts, rot, threads);  // 0: all cores; at most one per environment
     num_envs_ = num_envs;
-    threads_ = pool_->size();
+    threads_ = vec_->threads();
   }
 
   // fixed at construction (readable after close)
@@ -671,11 +669,12 @@ class PyVecEnv {
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
-      if (envs_.empty()) closed_error();
+      if (!vec_) closed_error();
       const std::uint64_t base = seed ? *(last_seed_ = *seed) : next_seed(last_seed_);
-      for_each_env([&](std::size_t i) {
+      vec_->for_each([&](int e) {
+        const auto i = static_cast<std::size_t>(e);
         seeds_[i] = base + i;
-        const Eigen::VectorXd& o = envs_[i].reset(seeds_[i]);
+        const Eigen::VectorXd& o = vec_->env(e).reset(seeds_[i]);
         std::copy(o.data(), o.data() + o.size(), out + i * static_cast<std::size_t>(o.size()));
       });
       started_ = true;
@@ -690,9 +689,7 @@ class PyVecEnv {
   void close() {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(mutex_);
-    pool_.reset();
-    envs_.clear();
-    envs_.shrink_to_fit();
+    vec_.reset();
   }
 
   py::tuple step(py::handle actions) {
@@ -714,16 +711,16 @@ class PyVecEnv {
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
-      if (envs_.empty()) closed_error();
+      if (!vec_) closed_error();
       if (!started_) throw std::runtime_error("step: called before reset() (call envs.reset(seed=...) first)");
-      for_each_env([&](std::size_t i) {
-        const sim::StepResult& r = envs_[i].step(std::span<const double>(in + i * kActionDim, kActionDim));
+      vec_->step(std::span<const double>(in, n * kActionDim), [&](int e, const sim::StepResult& r) {
+        const auto i = static_cast<std::size_t>(e);
         Row& row = rows[i];
-        row.result_of(r, envs_[i].episode(), step_flags(r, options_.ignore_terminations));
+        row.result_of(r, vec_->env(e).episode(), step_flags(r, options_.ignore_terminations));
         std::copy(r.obs.data(), r.obs.data() + d, fo + i * d);
         if (row.flags.ended()) {
           seeds_[i] = eval::splitmix64(seeds_[i]);
-          const Eigen::VectorXd& first = envs_[i].reset(seeds_[i]);
+          const Eigen::VectorXd& first = vec_->env(e).reset(seeds_[i]);
           std::copy(first.data(), first.data() + d, o + i * d);
         } else {
           std::copy(r.obs.data(), r.obs.data() + d, o + i * d);
@@ -800,15 +797,6 @@ class PyVecEnv {
     info["clipped_steps"] = clipped;
     return info;
   }
-  template <typename F>
-  void for_each_env(F&& f) {
-    const std::size_t n = envs_.size();
-    const unsigned t = pool_->size();
-    const std::function<void(unsigned)> chunk = [&](unsigned w) {
-      for (std::size_t i = w; i < n; i += t) f(i);
-    };
-    pool_->run(chunk);
-  }
   static py::array_t<std::uint64_t> vec_u64(const std::vector<std::uint64_t>& v) {
     py::array_t<std::uint64_t> out(static_cast<py::ssize_t>(v.size()));
     std::copy(v.begin(), v.end(), out.mutable_data());
@@ -819,11 +807,10 @@ class PyVecEnv {
   int num_envs_{0};
   unsigned threads_{1};
   std::mutex mutex_;                          // guards everything below
-  std::vector<sim::HiddenContractEnv> envs_;  // empty once closed
+  std::unique_ptr<sim::VecEnv> vec_;         // the environments and their worker pool; null once closed
   std::vector<std::uint64_t> seeds_;
   std::optional<std::uint64_t> last_seed_;
   bool started_{false};
-  std::unique_ptr<WorkerPool> pool_;
 };
 
 // Frames as `actionshift render` writes them: FILE.gif (every frame, then the last held for a

@@ -8,6 +8,7 @@
 #include "actionshift/policy/rollout.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
+#include "actionshift/sim/vec_env.hpp"
 
 #include <Eigen/QR>
 
@@ -382,7 +383,6 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(o.threads);
-  WorkerPool pool(threads);  // one pool for the whole run: environment steps and gradient chunks
   auto model = sim::EnvModel::make(o.task, sim::profile_config(o.profile));
   const int env_obs_dim = model->layout().size();
   const int hist_dim = o.delay_aware ? kHistoryLength * kActionDim : 0;
@@ -392,10 +392,12 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
   const int iterations = static_cast<int>(std::max<std::int64_t>(1, o.total_steps / per_iter));
   PpoLearner learner(o, obs_dim);
 
-  // environments, each with its own noise stream and episode counter; a delay-aware run wraps each
-  // episode in the identity contract plus a lag drawn for that episode
-  std::vector<std::unique_ptr<sim::Env>> envs;
-  std::vector<std::optional<sim::HiddenContractEnv>> lagged(static_cast<std::size_t>(n_env));
+  // the vectorised environment (sim::VecEnv), each environment with its own noise stream and episode
+  // counter; a delay-aware run gives each episode the identity contract plus a lag drawn for it. Its pool
+  // is the run's one pool: environment steps and gradient chunks
+  sim::VecEnv vec(model, std::vector<Contract>(static_cast<std::size_t>(n_env), Contract::identity()),
+                  sim::FrameRotation::kLive, threads);
+  WorkerPool& pool = vec.pool();
   std::vector<Rng> noise;
   std::vector<std::uint64_t> episode_count(static_cast<std::size_t>(n_env), 0);
   Eigen::MatrixXf cur = Eigen::MatrixXf::Zero(obs_dim, n_env);
@@ -404,18 +406,15 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
     const auto ue = static_cast<std::size_t>(e);
     const std::uint64_t k = episode_count[ue]++;
     const std::uint64_t seed = derive_seed({o.seed, kPpoStream, 2, static_cast<std::uint64_t>(e), k});
-    if (!o.delay_aware) {
-      cur.col(e) = envs[ue]->reset(seed).cast<float>();
-      return;
+    if (o.delay_aware) {
+      ContractFields f;
+      f.lag = kTrainingLags[derive_seed({o.seed, kPpoStream, 5, static_cast<std::uint64_t>(e), k}) % 4];
+      vec.set_contract(e, Contract::make(f));
     }
-    ContractFields f;
-    f.lag = kTrainingLags[derive_seed({o.seed, kPpoStream, 5, static_cast<std::uint64_t>(e), k}) % 4];
-    lagged[ue].emplace(model, Contract::make(f));
-    cur.col(e).head(env_obs_dim) = lagged[ue]->reset(seed).cast<float>();
-    cur.col(e).tail(hist_dim).setZero();
+    cur.col(e).head(env_obs_dim) = vec.env(e).reset(seed).cast<float>();
+    if (hist_dim > 0) cur.col(e).tail(hist_dim).setZero();
   };
   for (int e = 0; e < n_env; ++e) {
-    if (!o.delay_aware) envs.push_back(std::make_unique<sim::Env>(model));
     noise.emplace_back(derive_seed({o.seed, kPpoStream, 1, static_cast<std::uint64_t>(e)}));
     reset_env(e);
   }
@@ -456,35 +455,29 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       batch.actions.middleCols(base, n_env) = act;
       batch.log_probs.segment(base, n_env) = lp;
       values.segment(base, n_env) = val;
-      std::atomic<int> next{0};
-      pool.run([&](unsigned) {
-        while (true) {
-          const int e = next.fetch_add(1);
-          if (e >= n_env) break;
-          const auto ue = static_cast<std::size_t>(e);
-          Action a = act.col(e).cast<double>().cwiseMax(-1.0).cwiseMin(1.0);
-          const sim::StepResult& r = o.delay_aware ? lagged[ue]->step(a) : envs[ue]->step(a);
-          step_reward[ue] = static_cast<float>(r.reward);
-          const bool success = r.success;
-          const bool over = r.episode_over();
-          step_success[ue] = success ? 1 : 0;
-          step_end[ue] = (success || over) ? 1 : 0;
-          step_boot[ue] = bootstraps(success, r.truncated, r.safety, o.bootstrap_success) ? 1 : 0;
-          // next network input, built in this env's final_obs column (no allocation per step; the
-          // column is read only when the episode ended): the observation and, delay-aware, the
-          // history shifted by the executed action
-          auto next = final_obs.col(e);
-          next.head(env_obs_dim) = r.obs.cast<float>();
-          if (hist_dim > 0) {
-            next.segment(env_obs_dim + kActionDim, hist_dim - kActionDim) = cur.col(e).segment(env_obs_dim, hist_dim - kActionDim);
-            next.segment(env_obs_dim, kActionDim) = a.cast<float>();
-          }
-          if (step_end[ue]) {
-            step_return[ue] = o.delay_aware ? lagged[ue]->episode().episode_return : envs[ue]->episode().episode_return;
-            reset_env(e);
-          } else {
-            cur.col(e) = next;
-          }
+      const Eigen::MatrixXd act_d = act.cast<double>().cwiseMax(-1.0).cwiseMin(1.0);  // column e: env e's action
+      vec.step(std::span<const double>(act_d.data(), static_cast<std::size_t>(act_d.size())), [&](int e, const sim::StepResult& r) {
+        const auto ue = static_cast<std::size_t>(e);
+        step_reward[ue] = static_cast<float>(r.reward);
+        const bool success = r.success;
+        const bool over = r.episode_over();
+        step_success[ue] = success ? 1 : 0;
+        step_end[ue] = (success || over) ? 1 : 0;
+        step_boot[ue] = bootstraps(success, r.truncated, r.safety, o.bootstrap_success) ? 1 : 0;
+        // next network input, built in this env's final_obs column (no allocation per step; the
+        // column is read only when the episode ended): the observation and, delay-aware, the
+        // history shifted by the executed action
+        auto next = final_obs.col(e);
+        next.head(env_obs_dim) = r.obs.cast<float>();
+        if (hist_dim > 0) {
+          next.segment(env_obs_dim + kActionDim, hist_dim - kActionDim) = cur.col(e).segment(env_obs_dim, hist_dim - kActionDim);
+          next.segment(env_obs_dim, kActionDim) = act_d.col(e).cast<float>();
+        }
+        if (step_end[ue]) {
+          step_return[ue] = vec.env(e).episode().episode_return;
+          reset_env(e);  // r is not read after this: the reset (or a new contract) replaces it
+        } else {
+          cur.col(e) = next;
         }
       });
       bool any_boot = false;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file The project's one worker pool: every parallel loop (the evaluation runner, policy rollouts,
-/// DAgger data collection, PPO, the Python module's VecEnv, the environment bench) runs its workers
-/// through WorkerPool, so thread counts, joining and error propagation behave the same everywhere.
+/// DAgger data collection, the vectorised environment sim::VecEnv of PPO and the Python module's
+/// make_vec, the environment bench) runs its workers through WorkerPool, so thread counts, joining and
+/// error propagation behave the same everywhere.
 ///
 /// A pool keeps `size` threads for its lifetime; each round (start/join, or run) has every worker run
 /// `body(worker_index)` once (a body typically pulls work items from a shared atomic counter), and
