@@ -4,6 +4,7 @@
 #include "actionshift/core/workers.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -27,10 +28,12 @@ void VecEnv::set_contract(int i, const Contract& contract) {
 }
 
 void VecEnv::for_each(const std::function<void(int)>& f) {
+  // environments are handed out one at a time (a step with contact costs several times one without),
+  // so a worker that drew cheap ones takes the next; results go to slots by index, never by worker
   const int n = size();
-  const int t = static_cast<int>(pool_->size());
-  pool_->run([&](unsigned w) {
-    for (int i = static_cast<int>(w); i < n; i += t) f(i);
+  std::atomic<int> next{0};
+  pool_->run([&](unsigned) {
+    for (int i = next.fetch_add(1); i < n; i = next.fetch_add(1)) f(i);
   });
 }
 
