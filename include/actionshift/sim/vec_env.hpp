@@ -4,7 +4,7 @@
 /// run on it. Each environment keeps its own Bullet world, episode and seed; step() runs environment i
 /// with row i of the actions and then `then(i, result)` on the same worker, so per-environment work (an
 /// automatic reset, copying a row out) runs in parallel too. Write results by environment index, never
-/// by worker: the outcome then does not depend on the number of threads (docs/sim.md, "Threads").
+/// by worker: the outcome then does not depend on the number of threads (docs/sim.md §9).
 
 #include "actionshift/core/contract.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
