@@ -37,10 +37,10 @@
 #include "actionshift/sim/controller.hpp"
 #include "actionshift/sim/env.hpp"
 #include "actionshift/sim/hidden_contract_env.hpp"
-#include "actionshift/sim/vec_env.hpp"
 #include "actionshift/sim/robot_source.hpp"
 #include "actionshift/sim/scene.hpp"
 #include "actionshift/sim/task.hpp"
+#include "actionshift/sim/vec_env.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

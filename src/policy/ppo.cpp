@@ -7,7 +7,6 @@
 #include "actionshift/core/workers.hpp"
 #include "actionshift/policy/rollout.hpp"
 #include "actionshift/sim/env.hpp"
-#include "actionshift/sim/hidden_contract_env.hpp"
 #include "actionshift/sim/vec_env.hpp"
 
 #include <Eigen/QR>
@@ -20,7 +19,6 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
-#include <optional>
 #include <stdexcept>
 
 namespace actionshift::policy {
@@ -434,6 +432,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       step_success(static_cast<std::size_t>(n_env));
   std::vector<double> step_return(static_cast<std::size_t>(n_env));
   Eigen::MatrixXf final_obs(obs_dim, n_env);
+  Eigen::MatrixXd act_d(kActionDim, n_env);  // the step's actions as the environments take them, column e for env e
 
   PpoResult result;
   std::int64_t env_steps = 0;
@@ -455,7 +454,7 @@ PpoResult train_ppo(const PpoOptions& o, const nlohmann::json& provenance,
       batch.actions.middleCols(base, n_env) = act;
       batch.log_probs.segment(base, n_env) = lp;
       values.segment(base, n_env) = val;
-      const Eigen::MatrixXd act_d = act.cast<double>().cwiseMax(-1.0).cwiseMin(1.0);  // column e: env e's action
+      act_d = act.cast<double>().cwiseMax(-1.0).cwiseMin(1.0);  // same size every step: no allocation
       vec.step(std::span<const double>(act_d.data(), static_cast<std::size_t>(act_d.size())), [&](int e, const sim::StepResult& r) {
         const auto ue = static_cast<std::size_t>(e);
         step_reward[ue] = static_cast<float>(r.reward);
