@@ -136,22 +136,26 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
   std::map<std::string, std::string> listed;
   for (std::string sha, file; sums >> sha >> file;) listed[file] = sha;
   int files = 0;
-  // the backbones themselves, under stages/ the files a committed backbone was warm-started from
-  // (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs),
+  // the backbones themselves (MLP and PPO actors, .asmlp; Diffusion Policies, .asdp), under stages/ the
+  // files a committed backbone was warm-started from (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs),
   // and under replicas/ the independently trained replicas (<task>.ppo.seed<S>.asmlp, `mlp:<path>`)
   const std::filesystem::path root = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
   for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
     const std::string name = entry.path().filename().string();
-    if (!name.ends_with(".asmlp")) continue;
+    const bool dp = name.ends_with(".asdp");  // an adopted Diffusion Policy, <task>.dp.asdp (backbone `dp`)
+    if (!name.ends_with(".asmlp") && !dp) continue;
     ++files;
     const std::string rel = std::filesystem::relative(entry.path(), root).generic_string();
     std::ifstream f(entry.path(), std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     EXPECT_EQ(listed[rel], sha256_hex(bytes)) << rel << " vs SHA256SUMS";
-    const std::string stem = name.substr(0, name.size() - 6);
+    const std::string stem = name.substr(0, name.size() - (dp ? 5 : 6));
     const auto dot = stem.find('.');
     ASSERT_NE(dot, std::string::npos) << name;
     const sim::TaskId task = sim::parse_task(stem.substr(0, dot));
+    if (dp) {
+      ASSERT_EQ(rel, std::string(sim::task_name(task)) + ".dp.asdp") << "a Diffusion Policy file is named <task>.dp.asdp";
+    }
     if (rel != name) {  // a stage or a replica: loads as a weight file of its task
       ASSERT_TRUE(rel.rfind("stages/", 0) == 0 || rel.rfind("replicas/", 0) == 0) << rel;
       EXPECT_EQ(policy::MlpPolicy::from_file(entry.path().string())->task(), task) << rel;
@@ -162,6 +166,7 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
     ro.backbones_dir = root.string();
     auto p = policy::make_policy(stem.substr(dot + 1), task, ro);
     EXPECT_EQ(p->task(), task) << name;
+    EXPECT_EQ(p->name(), stem.substr(dot + 1)) << name;
     EXPECT_EQ(p->sha256(), sha256_hex(bytes)) << name;
   }
   EXPECT_EQ(files, static_cast<int>(listed.size()));
