@@ -31,7 +31,10 @@ def main():
             name = c["backbone"] if not c["backbone"].startswith("external:") else f"`{c['backbone']}`"
             ppo = numbers.by_id(f"table1.{c['task']}.clean_success")
             dp = numbers.by_id(f"s5.8.{c['task']}.diffusion_policy.clean_success")
-            rows.append([name, c["task"], c.get("profile", "?"), f"{comp['successes']}/{comp['total']}", fmt.rate(comp),
+            # a verdict names its horizon only when it is not the task's (the Diffusion Policy runs at 100)
+            horizon = str(c["horizon"]) if "horizon" in c else "task's"
+            rows.append([name, c["task"], c.get("profile", "?"), horizon, f"{comp['successes']}/{comp['total']}",
+                         fmt.rate(comp),
                          f"{wr['successes']}/{wr['total']} = {fmt.num(wr['rate'])}", fmt.num(par["absolute_difference"], 4),
                          "pass" if par["two_point_rule"] else "fail", "pass" if par["overlap_rule"] else "fail",
                          f"**{c['decision']}**", paper.entry_value(ppo), paper.entry_value(dp), os.path.basename(path)])
@@ -43,9 +46,10 @@ def main():
             " of its frozen Diffusion Policy (§5.8), on the same task, where it gives one; the paper's backbones are"
             " not ours, so these are the levels a competent backbone reaches there, not a reproduction target.")
     block = "\n".join([head, "", note, "", table.markdown(
-        ["backbone", "task", "profile", "success_once (unwrapped)", "rate [Wilson 95 %]", "identity-wrapped", "abs. diff",
-         "two-point rule", "overlap rule", "decision", "paper frozen PPO (Table 1)", "paper Diffusion Policy (§5.8)",
-         "verdict file"], rows, ["l", "l", "l", "r", "l", "r", "r", "l", "l", "l", "l", "l", "l"]).rstrip("\n")])
+        ["backbone", "task", "profile", "horizon", "success_once (unwrapped)", "rate [Wilson 95 %]", "identity-wrapped",
+         "abs. diff", "two-point rule", "overlap rule", "decision", "paper frozen PPO (Table 1)",
+         "paper Diffusion Policy (§5.8)", "verdict file"], rows,
+        ["l", "l", "l", "r", "r", "l", "r", "r", "l", "l", "l", "l", "l", "l"]).rstrip("\n")])
     with open(a.page) as f:
         text = f.read()
     begin, end = "<!-- gate0:begin -->", "<!-- gate0:end -->"

@@ -102,8 +102,17 @@ for page in $PAGES; do
     done ;;
   gate0)
     mkdir -p "$D/$page/verdicts"
+    # the page the report rewrites between its markers (the text around them must survive)
+    printf '%s\n' '# Gate 0 results (golden-test template)' '' 'Hand-written text above the markers is kept.' '' \
+        '<!-- gate0:begin -->' '(replaced)' '<!-- gate0:end -->' '' 'Hand-written text below the markers is kept.' > "$D/$page/page.md"
     "$AS" gate0 --backbone expert --task pick_cube --episodes "$N" --threads 1 --quiet --out "$D/$page/verdicts/expert.pick_cube.json" > /dev/null || true
-    "$AS" gate0 --backbone mlp --task push_cube --episodes "$N" --threads 1 --quiet --out "$D/$page/verdicts/mlp.push_cube.json" > /dev/null || true ;;
+    "$AS" gate0 --backbone mlp --task push_cube --episodes "$N" --threads 1 --quiet --out "$D/$page/verdicts/mlp.push_cube.json" > /dev/null || true
+    # a tiny Diffusion Policy as the built-in `dp`, at the horizon it is evaluated at (the page's horizon column)
+    bdir=$(mktemp -d)
+    "$AS" train dp --task pick_cube --demos 2 --iterations 1 --down-dims 8,16 --seed 1 --threads 1 --out "$bdir/pick_cube.dp.asdp" > /dev/null
+    ACTIONSHIFT_BACKBONES_DIR="$bdir" "$AS" gate0 --backbone dp --task pick_cube --episodes "$N" --horizon 100 --threads 1 --quiet \
+        --out "$D/$page/verdicts/dp.pick_cube.json" > /dev/null || true
+    rm -rf "$bdir" ;;
   identifiers)
     mkdir -p "$D/$page/results/train" "$D/$page/results/eval"
     for kind in osi probe_osi recurrent_osi; do
