@@ -137,8 +137,9 @@ TEST(MlpBackbones, EveryCommittedWeightFileIsListedWithItsChecksumAndLoadsAsItsB
   for (std::string sha, file; sums >> sha >> file;) listed[file] = sha;
   int files = 0;
   // the backbones themselves (MLP and PPO actors, .asmlp; Diffusion Policies, .asdp), under stages/ the
-  // files a committed backbone was warm-started from (`train ppo --init-from`; named <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs),
-  // and under replicas/ the independently trained replicas (<task>.ppo.seed<S>.asmlp, `mlp:<path>`)
+  // files a committed backbone was warm-started from (`train ppo --init-from`; named
+  // <task>.<backbone>.<env steps>.asmlp, kept so its command re-runs), and under replicas/ the
+  // independently trained replicas (<task>.ppo.seed<S>.asmlp, `mlp:<path>`)
   const std::filesystem::path root = ACTIONSHIFT_SOURCE_DIR "/configs/backbones";
   for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
     const std::string name = entry.path().filename().string();
