@@ -131,29 +131,53 @@ double DpLearner::step(const std::vector<DpMat<float>>& actions, const std::vect
   }
   const int n_shards = std::min(o_.shards, B);
   const auto P = static_cast<std::size_t>(net_.parameter_count());
-  std::vector<std::vector<float>> grads(static_cast<std::size_t>(n_shards));
+  std::vector<std::vector<float>>& grads = grads_;  // kept between steps: no fresh pages every step
+  grads.resize(static_cast<std::size_t>(n_shards));
   std::vector<double> losses(static_cast<std::size_t>(B));
   const float scale = 2.0f / static_cast<float>(static_cast<double>(B) * a.action_dim * a.pred_horizon);
-  std::atomic<int> next{0};
   const int T = schedule_.steps();
-  run_workers(std::max(1u, std::min(resolve_threads(threads), static_cast<unsigned>(n_shards))), [&](unsigned) {
-    auto ws = net_.workspace();
-    for (int s = next.fetch_add(1); s < n_shards; s = next.fetch_add(1)) {
-      std::vector<float>& g = grads[static_cast<std::size_t>(s)];
-      g.assign(P, 0.0f);
-      const int lo = static_cast<int>(static_cast<std::int64_t>(B) * s / n_shards);
-      const int hi = static_cast<int>(static_cast<std::int64_t>(B) * (s + 1) / n_shards);
-      for (int k = lo; k < hi; ++k) {
-        const auto sk = static_cast<std::size_t>(k);
+  auto shard_begin = [&](int s) { return static_cast<int>(static_cast<std::int64_t>(B) * s / n_shards); };
+  // Each worker runs a run of consecutive shards as one batch through the network (DpUnet's batched
+  // forward and backward give every sample the bits it gets alone); every sample adds its gradient
+  // to its shard's, in sample order. So the bytes do not depend on the thread count.
+  while (workspaces_.size() < static_cast<std::size_t>(B)) workspaces_.push_back(net_.workspace());
+  const unsigned workers = std::max(1u, std::min(resolve_threads(threads), static_cast<unsigned>(n_shards)));
+  std::atomic<unsigned> next{0};
+  run_workers(workers, [&](unsigned) {
+    for (unsigned w = next.fetch_add(1); w < workers; w = next.fetch_add(1)) {
+      const int s0 = static_cast<int>(static_cast<std::int64_t>(n_shards) * w / workers);
+      const int s1 = static_cast<int>(static_cast<std::int64_t>(n_shards) * (w + 1) / workers);
+      const int lo = shard_begin(s0), hi = shard_begin(s1);
+      const auto n = static_cast<std::size_t>(hi - lo);
+      if (n == 0) continue;
+      std::vector<float*> g(n);
+      for (int s = s0; s < s1; ++s) {
+        std::vector<float>& gs = grads[static_cast<std::size_t>(s)];
+        gs.assign(P, 0.0f);
+        for (int k = shard_begin(s); k < shard_begin(s + 1); ++k) g[static_cast<std::size_t>(k - lo)] = gs.data();
+      }
+      std::vector<DpMat<float>> noise(n), noisy(n);
+      std::vector<DpVec<float>> cond(n);
+      std::vector<double> steps(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(lo) + i;
         Rng rng(derive_seed({seed_, kDpNoiseStream, static_cast<std::uint64_t>(t_), static_cast<std::uint64_t>(k)}));
         const int t = static_cast<int>(rng.uniform_int(static_cast<std::uint64_t>(T)));
-        const DpMat<float> noise = normal_mat(rng, a.action_dim, a.pred_horizon);
+        noise[i] = normal_mat(rng, a.action_dim, a.pred_horizon);
         const double ab = schedule_.alphas_cumprod[static_cast<std::size_t>(t)];
-        const DpMat<float> noisy = static_cast<float>(std::sqrt(ab)) * actions[sk] + static_cast<float>(std::sqrt(1.0 - ab)) * noise;
-        const DpMat<float> diff = net_.forward(params_.data(), noisy, t, conds[sk], *ws) - noise;
-        losses[sk] = diff.cast<double>().squaredNorm();
-        net_.backward(params_.data(), scale * diff, *ws, g.data());
+        noisy[i] = static_cast<float>(std::sqrt(ab)) * actions[k] + static_cast<float>(std::sqrt(1.0 - ab)) * noise[i];
+        steps[i] = t;
+        cond[i] = conds[k];
       }
+      std::vector<DpUnet<float>::Workspace*> ws(n);
+      for (std::size_t i = 0; i < n; ++i) ws[i] = workspaces_[static_cast<std::size_t>(lo) + i].get();
+      std::vector<DpMat<float>> diff = net_.forward(params_.data(), noisy, steps, cond, ws);
+      for (std::size_t i = 0; i < n; ++i) {
+        diff[i] -= noise[i];
+        losses[static_cast<std::size_t>(lo) + i] = diff[i].cast<double>().squaredNorm();
+        diff[i] *= scale;
+      }
+      net_.backward(params_.data(), diff, ws, g);
     }
   });
   // fixed-order reductions

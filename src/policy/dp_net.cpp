@@ -179,85 +179,130 @@ std::shared_ptr<typename DpUnet<S>::Workspace> DpUnet<S>::workspace() const {
 
 template <class S>
 Mat<S> DpUnet<S>::forward(const S* p, const Mat<S>& x_in, double step, const Vec<S>& global_cond, Workspace& ws) const {
-  const Spec& sp = *spec_;
-  if (x_in.rows() != arch_.action_dim || x_in.cols() != arch_.pred_horizon)
-    throw std::invalid_argument("DpUnet::forward: x must be " + std::to_string(arch_.action_dim) + " x " + std::to_string(arch_.pred_horizon));
-  if (global_cond.size() != arch_.obs_horizon * arch_.obs_dim)
-    throw std::invalid_argument("DpUnet::forward: global condition must have " + std::to_string(arch_.obs_horizon * arch_.obs_dim) + " entries");
-  // sinusoidal step embedding (diffusion_policy's SinusoidalPosEmb)
-  const int d = arch_.step_embed_dim, half = d / 2;
-  ws.emb.resize(d);
-  const double scale = std::log(10000.0) / (half - 1);
-  for (int i = 0; i < half; ++i) {
-    const double a = step * std::exp(-scale * i);
-    ws.emb(i) = static_cast<S>(std::sin(a));
-    ws.emb(half + i) = static_cast<S>(std::cos(a));
-  }
-  ws.h1 = linear_fwd(sp.step1, p, ws.emb);
-  ws.mh1 = mish_of(ws.h1);
-  ws.cond.resize(arch_.cond_dim());
-  ws.cond.head(d) = linear_fwd(sp.step2, p, ws.mh1);
-  ws.cond.tail(global_cond.size()) = global_cond;
-  ws.mcond = mish_of(ws.cond);
-
-  const int levels = static_cast<int>(arch_.down_dims.size());
-  std::vector<Mat<S>> skips;
-  Mat<S> x = x_in;
-  for (int l = 0; l < levels; ++l) {
-    const auto i0 = static_cast<std::size_t>(2 * l);
-    x = res_fwd(sp.down[i0], p, x, ws.mcond, ws.down[i0]);
-    x = res_fwd(sp.down[i0 + 1], p, x, ws.mcond, ws.down[i0 + 1]);
-    skips.push_back(x);
-    if (l + 1 < levels) x = conv_fwd(sp.downsample[static_cast<std::size_t>(l)], p, x, ws.downsample[static_cast<std::size_t>(l)]);
-  }
-  x = res_fwd(sp.mid[0], p, x, ws.mcond, ws.mid[0]);
-  x = res_fwd(sp.mid[1], p, x, ws.mcond, ws.mid[1]);
-  for (int u = 0; u + 1 < levels; ++u) {
-    const auto su = static_cast<std::size_t>(u);
-    const Mat<S>& skip = skips[static_cast<std::size_t>(levels - 1 - u)];
-    ws.up_channels[su] = static_cast<int>(x.rows());
-    Mat<S> cat(x.rows() + skip.rows(), x.cols());
-    cat << x, skip;
-    x = res_fwd(sp.up[2 * su], p, cat, ws.mcond, ws.up[2 * su]);
-    x = res_fwd(sp.up[2 * su + 1], p, x, ws.mcond, ws.up[2 * su + 1]);
-    x = tconv_fwd(sp.upsample[su], p, x, ws.upsample[su]);
-  }
-  x = block_fwd(sp.final_block, p, x, ws.fin_block);
-  return conv_fwd(sp.final_conv, p, x, ws.fin_conv);
+  Workspace* w = &ws;
+  return std::move(forward(p, Batch<S>{x_in}, {step}, {global_cond}, std::span<Workspace* const>(&w, 1))[0]);
 }
 
 template <class S>
 void DpUnet<S>::backward(const S* p, const Mat<S>& dy, Workspace& ws, S* g, Mat<S>* dx_out) const {
+  Workspace* w = &ws;
+  Batch<S> dx = backward(p, Batch<S>{dy}, std::span<Workspace* const>(&w, 1), std::span<S* const>(&g, 1));
+  if (dx_out != nullptr) *dx_out = std::move(dx[0]);
+}
+
+template <class S>
+std::vector<Mat<S>> DpUnet<S>::forward(const S* p, const std::vector<Mat<S>>& x_in, const std::vector<double>& steps,
+                                       const std::vector<Vec<S>>& global_cond, std::span<Workspace* const> ws) const {
   const Spec& sp = *spec_;
+  const std::size_t n = x_in.size();
+  if (steps.size() != n || global_cond.size() != n || ws.size() != n)
+    throw std::invalid_argument("DpUnet::forward: one step, condition and workspace per sample");
+  const int d = arch_.step_embed_dim, half = d / 2;
+  const double scale = std::log(10000.0) / (half - 1);
+  for (std::size_t b = 0; b < n; ++b) {
+    if (x_in[b].rows() != arch_.action_dim || x_in[b].cols() != arch_.pred_horizon)
+      throw std::invalid_argument("DpUnet::forward: x must be " + std::to_string(arch_.action_dim) + " x " + std::to_string(arch_.pred_horizon));
+    if (global_cond[b].size() != arch_.obs_horizon * arch_.obs_dim)
+      throw std::invalid_argument("DpUnet::forward: global condition must have " + std::to_string(arch_.obs_horizon * arch_.obs_dim) + " entries");
+    // sinusoidal step embedding (diffusion_policy's SinusoidalPosEmb)
+    Workspace& w = *ws[b];
+    w.emb.resize(d);
+    for (int i = 0; i < half; ++i) {
+      const double a = steps[b] * std::exp(-scale * i);
+      w.emb(i) = static_cast<S>(std::sin(a));
+      w.emb(half + i) = static_cast<S>(std::cos(a));
+    }
+    w.h1 = linear_fwd(sp.step1, p, w.emb);
+    w.mh1 = mish_of(w.h1);
+    w.cond.resize(arch_.cond_dim());
+    w.cond.head(d) = linear_fwd(sp.step2, p, w.mh1);
+    w.cond.tail(global_cond[b].size()) = global_cond[b];
+    w.mcond = mish_of(w.cond);
+  }
+  auto mcond = [&](std::size_t b) -> const Vec<S>& { return ws[b]->mcond; };
+  auto res = [&](const Res& r, const Batch<S>& x, std::vector<ResC<S>> Workspace::*caches, std::size_t i) {
+    return res_fwd_each(r, p, x, mcond, [&](std::size_t b) -> ResC<S>& { return ((*ws[b]).*caches)[i]; });
+  };
+
   const int levels = static_cast<int>(arch_.down_dims.size());
-  Vec<S> dmcond = Vec<S>::Zero(arch_.cond_dim());
-  Mat<S> d = conv_bwd(sp.final_conv, p, dy, ws.fin_conv, g, true);
-  d = block_bwd(sp.final_block, p, d, ws.fin_block, g, true);
-  std::vector<Mat<S>> dskip(static_cast<std::size_t>(levels));
+  std::vector<Batch<S>> skips;
+  Batch<S> x = x_in;
+  for (int l = 0; l < levels; ++l) {
+    const auto i0 = static_cast<std::size_t>(2 * l);
+    x = res(sp.down[i0], x, &Workspace::down, i0);
+    x = res(sp.down[i0 + 1], x, &Workspace::down, i0 + 1);
+    skips.push_back(x);
+    const auto sl = static_cast<std::size_t>(l);
+    if (l + 1 < levels) x = conv_fwd_each(sp.downsample[sl], p, x, [&](std::size_t b) -> ConvC<S>& { return ws[b]->downsample[sl]; });
+  }
+  x = res(sp.mid[0], x, &Workspace::mid, 0);
+  x = res(sp.mid[1], x, &Workspace::mid, 1);
+  for (int u = 0; u + 1 < levels; ++u) {
+    const auto su = static_cast<std::size_t>(u);
+    const Batch<S>& skip = skips[static_cast<std::size_t>(levels - 1 - u)];
+    for (std::size_t b = 0; b < n; ++b) {
+      ws[b]->up_channels[su] = static_cast<int>(x[b].rows());
+      Mat<S> cat(x[b].rows() + skip[b].rows(), x[b].cols());
+      cat << x[b], skip[b];
+      x[b] = std::move(cat);
+    }
+    x = res(sp.up[2 * su], x, &Workspace::up, 2 * su);
+    x = res(sp.up[2 * su + 1], x, &Workspace::up, 2 * su + 1);
+    x = tconv_fwd_each(sp.upsample[su], p, x, [&](std::size_t b) -> Mat<S>& { return ws[b]->upsample[su]; });
+  }
+  x = block_fwd_each(sp.final_block, p, x, [&](std::size_t b) -> BlockC<S>& { return ws[b]->fin_block; });
+  return conv_fwd_each(sp.final_conv, p, x, [&](std::size_t b) -> ConvC<S>& { return ws[b]->fin_conv; });
+}
+
+template <class S>
+std::vector<Mat<S>> DpUnet<S>::backward(const S* p, const std::vector<Mat<S>>& dy, std::span<Workspace* const> ws,
+                                        std::span<S* const> grads) const {
+  const Spec& sp = *spec_;
+  const std::size_t n = dy.size();
+  if (ws.size() != n || grads.size() != n) throw std::invalid_argument("DpUnet::backward: one workspace and gradient per sample");
+  S* const* g = grads.data();
+  const int levels = static_cast<int>(arch_.down_dims.size());
+  std::vector<Vec<S>> dmcond(n, Vec<S>::Zero(arch_.cond_dim()));
+  auto mcond = [&](std::size_t b) -> const Vec<S>& { return ws[b]->mcond; };
+  auto dcond = [&](std::size_t b) -> Vec<S>& { return dmcond[b]; };
+  auto res = [&](const Res& r, const Batch<S>& d, std::vector<ResC<S>> Workspace::*caches, std::size_t i) {
+    return res_bwd_each(r, p, d, mcond, dcond, [&](std::size_t b) -> const ResC<S>& { return ((*ws[b]).*caches)[i]; }, g);
+  };
+  Batch<S> d = conv_bwd_each(sp.final_conv, p, dy, [&](std::size_t b) -> const ConvC<S>& { return ws[b]->fin_conv; }, g, true);
+  d = block_bwd_each(sp.final_block, p, d, [&](std::size_t b) -> const BlockC<S>& { return ws[b]->fin_block; }, g, true);
+  std::vector<Batch<S>> dskip(static_cast<std::size_t>(levels));
   for (int u = levels - 2; u >= 0; --u) {
     const auto su = static_cast<std::size_t>(u);
-    d = tconv_bwd(sp.upsample[su], p, d, ws.upsample[su], g);
-    d = res_bwd(sp.up[2 * su + 1], p, d, ws.mcond, dmcond, ws.up[2 * su + 1], g);
-    d = res_bwd(sp.up[2 * su], p, d, ws.mcond, dmcond, ws.up[2 * su], g);
-    const int cx = ws.up_channels[su];
-    dskip[static_cast<std::size_t>(levels - 1 - u)] = d.bottomRows(d.rows() - cx);
-    d = Mat<S>(d.topRows(cx));
+    d = tconv_bwd_each(sp.upsample[su], p, d, [&](std::size_t b) -> const Mat<S>& { return ws[b]->upsample[su]; }, g);
+    d = res(sp.up[2 * su + 1], d, &Workspace::up, 2 * su + 1);
+    d = res(sp.up[2 * su], d, &Workspace::up, 2 * su);
+    Batch<S>& skip = dskip[static_cast<std::size_t>(levels - 1 - u)];
+    skip.resize(n);
+    for (std::size_t b = 0; b < n; ++b) {
+      const int cx = ws[b]->up_channels[su];
+      skip[b] = d[b].bottomRows(d[b].rows() - cx);
+      d[b] = Mat<S>(d[b].topRows(cx));
+    }
   }
-  d = res_bwd(sp.mid[1], p, d, ws.mcond, dmcond, ws.mid[1], g);
-  d = res_bwd(sp.mid[0], p, d, ws.mcond, dmcond, ws.mid[0], g);
+  d = res(sp.mid[1], d, &Workspace::mid, 1);
+  d = res(sp.mid[0], d, &Workspace::mid, 0);
   for (int l = levels - 1; l >= 0; --l) {
     const auto sl = static_cast<std::size_t>(l);
-    if (l + 1 < levels) d = conv_bwd(sp.downsample[sl], p, d, ws.downsample[sl], g, true);
-    if (dskip[sl].size() > 0) d += dskip[sl];
-    d = res_bwd(sp.down[2 * sl + 1], p, d, ws.mcond, dmcond, ws.down[2 * sl + 1], g);
-    d = res_bwd(sp.down[2 * sl], p, d, ws.mcond, dmcond, ws.down[2 * sl], g);
+    if (l + 1 < levels) d = conv_bwd_each(sp.downsample[sl], p, d, [&](std::size_t b) -> const ConvC<S>& { return ws[b]->downsample[sl]; }, g, true);
+    if (!dskip[sl].empty())
+      for (std::size_t b = 0; b < n; ++b) d[b] += dskip[sl][b];
+    d = res(sp.down[2 * sl + 1], d, &Workspace::down, 2 * sl + 1);
+    d = res(sp.down[2 * sl], d, &Workspace::down, 2 * sl);
   }
-  if (dx_out != nullptr) *dx_out = d;
   // step encoder (the global condition is data: no gradient needed)
   const int sd = arch_.step_embed_dim;
-  const Vec<S> dse = dmcond.head(sd).cwiseProduct(mish_grad_of(ws.cond.head(sd)));
-  const Vec<S> dh1 = linear_bwd(sp.step2, p, dse, ws.mh1, g).cwiseProduct(mish_grad_of(ws.h1));
-  linear_bwd(sp.step1, p, dh1, ws.emb, g);
+  for (std::size_t b = 0; b < n; ++b) {
+    const Workspace& w = *ws[b];
+    const Vec<S> dse = dmcond[b].head(sd).cwiseProduct(mish_grad_of(w.cond.head(sd)));
+    const Vec<S> dh1 = linear_bwd(sp.step2, p, dse, w.mh1, g[b]).cwiseProduct(mish_grad_of(w.h1));
+    linear_bwd(sp.step1, p, dh1, w.emb, g[b]);
+  }
+  return d;
 }
 
 template class DpUnet<float>;

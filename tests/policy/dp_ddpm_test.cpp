@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -246,6 +247,78 @@ TEST(TrainDp, AnInterruptedRunContinuesFromItsCheckpointToTheSameBytes) {
   o.checkpoint_every = 0;
   EXPECT_THAT([&] { check_train_dp_options(o); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("checkpoint-every")));
   std::filesystem::remove_all(dir);
+}
+
+// Eigen blocks a product's depth by a length it derives from the L1 cache size, so the same training
+// rounds differently on machines with other caches (the learner alone shows it); train_dp fixes the
+// size it assumes, so its bytes are the same whatever the caller's (or the CPU's) setting, and it
+// gives the caller's setting back
+TEST(TrainDp, BytesDoNotDependOnTheMachinesL1Cache) {
+  const std::ptrdiff_t l1 = Eigen::l1CacheSize(), l2 = Eigen::l2CacheSize(), l3 = Eigen::l3CacheSize();
+  DpArch arch = toy_arch();
+  arch.down_dims = {8, 240};  // depth 240 x 3 = 720: blocked under a 32 KiB L1 (680), not under 48 KiB (1,016)
+  const ToyData d = toy_batch(6);
+  std::vector<std::vector<float>> learned;
+  for (const std::ptrdiff_t cache : {std::ptrdiff_t{32 * 1024}, std::ptrdiff_t{48 * 1024}}) {
+    Eigen::setCpuCacheSizes(cache, l2, l3);
+    DpLearnOptions o;
+    o.warmup_steps = 0;
+    DpLearner learner(arch, o, 5);
+    for (int i = 0; i < 2; ++i) learner.step(d.actions, d.conds, 1);
+    learned.push_back(learner.params());
+  }
+  EXPECT_NE(std::memcmp(learned[0].data(), learned[1].data(), learned[0].size() * sizeof(float)), 0)
+      << "the two cache sizes should block the depth differently";
+
+  TrainDpOptions o;
+  o.demos = 2;
+  o.iterations = 3;
+  o.batch_size = 4;
+  o.down_dims = {8, 144};  // depth 144 x 5 = 720, as above
+  o.threads = 1;
+  std::vector<std::string> bytes;
+  for (const std::ptrdiff_t cache : {std::ptrdiff_t{48 * 1024}, std::ptrdiff_t{32 * 1024}, std::ptrdiff_t{64 * 1024}}) {
+    Eigen::setCpuCacheSizes(cache, l2, l3);
+    bytes.push_back(serialize_dp(train_dp(o).weights));
+    EXPECT_EQ(Eigen::l1CacheSize(), cache) << "train_dp gives the caller's L1 size back";
+  }
+  EXPECT_TRUE(bytes[0] == bytes[1]) << "train_dp under a 32 KiB L1 differs from under 48 KiB";
+  EXPECT_TRUE(bytes[0] == bytes[2]) << "train_dp under a 64 KiB L1 differs from under 48 KiB";
+  Eigen::setCpuCacheSizes(l1, l2, l3);
+}
+
+// The committed pick_cube Diffusion Policy's own recipe, run to its first logged loss (iteration 50,
+// the mean of 50 minibatch losses): the bits must be the committed curve's, or the file cannot
+// re-train byte for byte (scripts/ppo_reproduce runs all 30,000 iterations, about 3.5 hours). About
+// 35 s on two cores: 1,000 expert demonstrations and 50 steps of the 4.39 M-parameter U-Net.
+TEST(TrainDp, ReproducesTheFirstLossOfTheCommittedPickCubeCurve) {
+  std::ifstream curve(ACTIONSHIFT_SOURCE_DIR "/docs/results/dp_pick_cube.curve.jsonl");
+  ASSERT_TRUE(curve.good());
+  std::string line;
+  std::getline(curve, line);
+  const nlohmann::json first = nlohmann::json::parse(line);
+  ASSERT_EQ(first.at("iteration").get<int>(), 50);
+  const double want = first.at("loss").get<double>();
+  TrainDpOptions o;  // the header's command: train dp --task pick_cube --seed 20260718 --demos 1000
+  o.task = sim::TaskId::kPickCube;  //   --iterations 30000 --batch 64 --down-dims 64,128,256 --lr 1e-4
+  o.seed = 20260718;
+  o.demos = 1000;
+  o.iterations = 30000;
+  o.batch_size = 64;
+  o.down_dims = {64, 128, 256};
+  o.learn.learning_rate = 1e-4;
+  o.profile = "maniskill";
+  o.threads = 0;
+  struct Stop {};
+  double got = 0.0;
+  EXPECT_THROW(train_dp(o,
+                        [&](const TrainDpProgress& p) {
+                          got = p.loss;
+                          throw Stop{};
+                        }),
+               Stop);
+  std::printf("iteration 50: loss %.17g (committed curve %.17g)\n", got, want);
+  EXPECT_EQ(std::memcmp(&got, &want, sizeof got), 0) << "got " << got << ", the committed curve " << want;
 }
 
 TEST(DpLearner, RejectsBadBatches) {

@@ -8,7 +8,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace actionshift::policy {
@@ -299,6 +301,54 @@ TEST(DpUnet, FloatMatchesDouble) {
   const M yd = nd.forward(pd.data(), x, 5.0, c, *wd);
   const DpMat<float> yf = nf.forward(pf.data(), x.cast<float>(), 5.0, c.cast<float>(), *wf);
   EXPECT_LT((yd - yf.cast<double>()).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+// Training runs the network on a batch at once (the weight products over the samples' columns side
+// by side). Every sample must get the bits it gets alone: the output, d/dx, and the gradient of samples
+// sharing a buffer summed in sample order, or the committed .asdp files would not re-train byte for byte.
+// The paper's configuration, so the depths Eigen blocks (1,280 and 2,560) and all three lengths (16, 8, 4)
+// are exercised, under both L1 sizes that block them differently.
+TEST(DpUnet, ABatchGivesEverySampleTheBitsItGetsAlone) {
+  const DpUnet<float> net{DpArch{}};
+  const std::vector<float> p = net.init(11);
+  const std::size_t n = 5;
+  Rng rng(12);
+  std::vector<DpMat<float>> x(n), dy(n);
+  std::vector<DpVec<float>> c(n);
+  std::vector<double> steps(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    x[b] = random_mat(rng, 7, 16).cast<float>();
+    dy[b] = random_mat(rng, 7, 16, 0.1).cast<float>();
+    c[b] = random_mat(rng, 84, 1).cast<float>();
+    steps[b] = static_cast<double>(17 * b);
+  }
+  const std::ptrdiff_t l1 = Eigen::l1CacheSize(), l2 = Eigen::l2CacheSize(), l3 = Eigen::l3CacheSize();
+  for (const std::ptrdiff_t cache : {std::ptrdiff_t{32 * 1024}, std::ptrdiff_t{48 * 1024}}) {
+    Eigen::setCpuCacheSizes(cache, l2, l3);
+    // one by one: samples 0-2 add to the first gradient, 3-4 to the second
+    std::vector<float> g1a(p.size(), 0.0f), g1b(p.size(), 0.0f), g2a(p.size(), 0.0f), g2b(p.size(), 0.0f);
+    std::vector<DpMat<float>> y1(n), dx1(n);
+    for (std::size_t b = 0; b < n; ++b) {
+      auto ws = net.workspace();
+      y1[b] = net.forward(p.data(), x[b], steps[b], c[b], *ws);
+      net.backward(p.data(), dy[b], *ws, (b < 3 ? g1a : g1b).data(), &dx1[b]);
+    }
+    std::vector<std::shared_ptr<DpUnet<float>::Workspace>> owned(n);
+    std::vector<DpUnet<float>::Workspace*> ws(n);
+    for (std::size_t b = 0; b < n; ++b) ws[b] = (owned[b] = net.workspace()).get();
+    const std::vector<DpMat<float>> y2 = net.forward(p.data(), x, steps, c, ws);
+    const std::vector<float*> g2{g2a.data(), g2a.data(), g2a.data(), g2b.data(), g2b.data()};
+    const std::vector<DpMat<float>> dx2 = net.backward(p.data(), dy, ws, g2);
+    for (std::size_t b = 0; b < n; ++b) {
+      ASSERT_EQ(y2[b].size(), y1[b].size());
+      EXPECT_EQ(std::memcmp(y2[b].data(), y1[b].data(), sizeof(float) * static_cast<std::size_t>(y1[b].size())), 0) << "output " << b << ", L1 " << cache;
+      ASSERT_EQ(dx2[b].size(), dx1[b].size());
+      EXPECT_EQ(std::memcmp(dx2[b].data(), dx1[b].data(), sizeof(float) * static_cast<std::size_t>(dx1[b].size())), 0) << "d/dx " << b << ", L1 " << cache;
+    }
+    EXPECT_EQ(std::memcmp(g2a.data(), g1a.data(), sizeof(float) * p.size()), 0) << "gradient of samples 0-2, L1 " << cache;
+    EXPECT_EQ(std::memcmp(g2b.data(), g1b.data(), sizeof(float) * p.size()), 0) << "gradient of samples 3-4, L1 " << cache;
+  }
+  Eigen::setCpuCacheSizes(l1, l2, l3);
 }
 
 // the paper's configuration (ManiSkill's state Diffusion Policy on PickCube): obs 42 x 2 stacked,

@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -102,6 +103,17 @@ class DpUnet {
   /// last forward on `ws`; if `dx` is given, sets it to d(loss)/d(x).
   void backward(const S* params, const DpMat<S>& dy, Workspace& ws, S* grad, DpMat<S>* dx = nullptr) const;
 
+  /// forward() of several samples at once (one workspace each): the same bits as each sample on its
+  /// own, faster, because every weight matrix is packed for the product once per batch rather than
+  /// once per sample (the samples' columns are multiplied side by side, and Eigen computes each
+  /// column of a product from that column alone). Used by DpLearner::step.
+  std::vector<DpMat<S>> forward(const S* params, const std::vector<DpMat<S>>& x, const std::vector<double>& steps,
+                                const std::vector<DpVec<S>>& global_cond, std::span<Workspace* const> ws) const;
+  /// backward() of the last batched forward on `ws`: sample b adds its gradient to grads[b] (samples
+  /// sharing a gradient add to it in batch order, as one-by-one calls would); returns d(loss)/d(x).
+  std::vector<DpMat<S>> backward(const S* params, const std::vector<DpMat<S>>& dy, std::span<Workspace* const> ws,
+                                 std::span<S* const> grads) const;
+
   struct Spec;  ///< layer offsets (defined in dp_net.cpp)
 
  private:
@@ -157,6 +169,8 @@ struct DpLearnOptions {
 class DpLearner {
  public:
   DpLearner(const DpArch& arch, const DpLearnOptions& options, std::uint64_t seed);
+  DpLearner(const DpLearner&) = delete;  // its scratch workspaces are not to be shared
+  DpLearner& operator=(const DpLearner&) = delete;
   /// One AdamW step of the noise-prediction loss on a batch: actions[k] is a clean chunk
   /// (action_dim x pred_horizon, in [-1, 1]), conds[k] its condition. For each sample a step
   /// t ~ U{0..T-1} and noise ~ N(0, I) are drawn from a generator seeded by (seed, step number, k);
@@ -191,6 +205,8 @@ class DpLearner {
   DdpmSchedule schedule_;
   std::vector<float> params_, m_, v_, ema_;
   int t_{0};
+  std::vector<std::vector<float>> grads_;  ///< scratch: one gradient per shard
+  std::vector<std::shared_ptr<DpUnet<float>::Workspace>> workspaces_;  ///< scratch: one per sample of the batch
 };
 
 // ---- weight file -------------------------------------------------------------------------------
