@@ -30,3 +30,10 @@ if(Python3_Interpreter_FOUND)
   add_test(NAME pages.dp_cost COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/dp_cost_test.py)
   set_tests_properties(pages.dp_cost PROPERTIES LABELS pages TIMEOUT 60)
 endif()
+if(TARGET actionshift AND ACTIONSHIFT_BUILD_BENCHMARKS)
+  # scripts/brittleness with a tiny Diffusion Policy: its cost step's benchmark files stay out of what compare reads
+  add_test(NAME pages.brittleness_dp_script
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/pages/brittleness_dp_script_test.sh ${CMAKE_BINARY_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/brittleness_dp_script)
+  set_tests_properties(pages.brittleness_dp_script PROPERTIES LABELS pages TIMEOUT 600)
+endif()
