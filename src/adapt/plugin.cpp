@@ -78,7 +78,7 @@ Rung parse_rung(std::string_view text, const std::string& source, const std::str
 
 Rung method_rung(const std::string& method) {
   if (auto p = find_method_plugin(method)) return p->rung;
-  if (method == "oracle") return Rung::oracle;
+  if (method == "oracle" || method == "delayed_oracle") return Rung::oracle;
   if (method == "grammar_belief") return Rung::grammar;
   if (method == "no_adapt" || parse_identifier_kind(method)) return Rung::none;
   (void)resolve_method_params(method);  // unknown names throw

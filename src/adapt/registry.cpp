@@ -20,13 +20,13 @@ namespace actionshift::adapt {
 const std::vector<std::string>& method_names() {
   static const std::vector<std::string> n{"oracle", "entropy_probes", "dualabi", "fixed_probes", "random_probes",
                                           "exact_belief", "grammar_belief", "osi", "probe_osi", "recurrent_osi",
-                                          "no_adapt"};
+                                          "no_adapt",       "delayed_oracle"};
   return n;
 }
 
 bool method_needs_pool(const std::string& m) {
   if (const auto plugin = find_method_plugin(m)) return plugin->rung == Rung::pool;
-  return m != "oracle" && m != "no_adapt" && m != "grammar_belief" && !parse_identifier_kind(m);
+  return m != "oracle" && m != "delayed_oracle" && m != "no_adapt" && m != "grammar_belief" && !parse_identifier_kind(m);
 }
 bool method_needs_calibration(const std::string& m) {
   if (const auto plugin = find_method_plugin(m)) return plugin->rung == Rung::pool || plugin->rung == Rung::grammar;
@@ -38,6 +38,8 @@ namespace {
 nlohmann::json defaults(const std::string& m) {
   if (const auto plugin = find_method_plugin(m)) return plugin->params;
   if (m == "oracle" || m == "no_adapt" || m == "exact_belief") return nlohmann::json::object();
+  // a diagnostic: the oracle after 6 steps (the paper's probe budget) of the backbone's actions sent unchanged
+  if (m == "delayed_oracle") return {{"delay", 6}, {"before", "no_adapt"}};
   if (m == "grammar_belief")  // the reference's operating points: 6 fixed pulses of 0.5; hold h2-r1 over 6 channels
     // the scale corrector's defaults are the reference's (§4.7: window 16, bounds 0.4..2.5, floor 0.05)
     return {{"probe", "none"},     {"budget", 6},        {"amplitude", 0.5},          {"hold_steps", 2},
@@ -143,6 +145,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   };
   one_of("probe", {"none", "fixed", "hold", "entropy"});
   one_of("after_probe", {"belief", "identity"});
+  one_of("before", {"no_adapt", "hold"});
   auto int_in = [&](const char* key, int lo, int hi) {
     if (out.contains(key) && (out[key].get<int>() < lo || out[key].get<int>() > hi))
       throw InputError("method " + method, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
@@ -161,6 +164,7 @@ nlohmann::json resolve_method_params(const std::string& method, const nlohmann::
   real_in("scale_max", 1.0, 1e9, "must be finite and at least 1");
   real_in("scale_floor", 0.0, 1e9, "must be finite and nonnegative");
   int_in("warmup", 1, 1000);
+  int_in("delay", 0, 1000000);
   if (out.contains("weights") && out["weights"].get<std::string>().empty())
     throw InputError("method " + method, "weights", "must name committed weights or a .asid file");
   return out;
@@ -231,6 +235,12 @@ std::unique_ptr<Adapter> make_adapter(const std::string& method, const nlohmann:
   if (method == "oracle") {
     if (!in.truth) throw InputError("method", "oracle", "needs the true contract (given by the runner; truth= in Python)");
     return std::make_unique<OracleAdapter>(*in.truth);
+  }
+  if (method == "delayed_oracle") {
+    if (!in.truth) throw InputError("method", method, "needs the true contract (given by the runner; truth= in Python)");
+    return std::make_unique<DelayedOracleAdapter>(
+        *in.truth, p.at("delay").get<int>(),
+        p.at("before").get<std::string>() == "hold" ? DelayedOracleAdapter::Before::kHold : DelayedOracleAdapter::Before::kNoAdapt);
   }
   if (!in.pool || in.pool->empty()) throw InputError("method", method, "needs a pool of candidate contracts (--pool on the command line, pool= in Python)");
   if (!in.model) throw InputError("method", method, "needs a response calibration");

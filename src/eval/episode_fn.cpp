@@ -3,6 +3,7 @@
 #include "actionshift/eval/episode_fn.hpp"
 
 #include "actionshift/adapt/identifier.hpp"
+#include "actionshift/adapt/plugin.hpp"
 
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/adapt/response.hpp"
@@ -96,7 +97,7 @@ struct Context {
     adapt::MethodInputs in;
     // the only privileged path: the oracle's view, which only the runner can construct
     const std::optional<sim::OracleRecorder> oracle =
-        job.method == "oracle" ? std::optional<sim::OracleRecorder>(detail::OracleAccess::view(env)) : std::nullopt;
+        adapt::method_rung(job.method) == adapt::Rung::oracle ? std::optional<sim::OracleRecorder>(detail::OracleAccess::view(env)) : std::nullopt;
     if (oracle) in.truth = &oracle->contract();
     if (!pool.empty()) in.pool = &pool;
     if (response) in.model = &*response;

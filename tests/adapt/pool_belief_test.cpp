@@ -117,5 +117,52 @@ TEST(OracleAndNoAdapt, OracleInvertsAbsoluteTargetsAndNoAdaptPassesThrough) {
   EXPECT_EQ(n.encode(intent(3), Mat3::Identity()), intent(3));
 }
 
+// the diagnostic oracle: `delay` steps of no adaptation (or of holding still through the truth), then the
+// oracle exactly, with the target it tracked through the delay (an absolute-target contract drifts while
+// the intents go unadapted, so an oracle that forgot those steps would miss by the drift)
+TEST(DelayedOracle, SendsTheIntentUnchangedForDelayStepsThenInvertsExactly) {
+  const Contract truth = reference::representative_contracts("unseen_composition")[0];
+  ASSERT_EQ(truth.lag(), 0);
+  for (const int delay : {0, 1, 6}) {
+    DelayedOracleAdapter o(truth, delay, DelayedOracleAdapter::Before::kNoAdapt);
+    Decoder env(truth);
+    for (int episode = 0; episode < 2; ++episode) {  // begin_episode clears the count and the replica
+      o.begin_episode(0);
+      env.reset_all();
+      Rng rng(11);
+      for (int k = 0; k < 20; ++k) {
+        const Mat3 R = actionshift::testing::random_rotation(rng);
+        const Action raw = o.encode(intent(k), R);
+        const Action exec = env.step(raw, R);
+        o.observe(raw, Pose6::Zero(), R);
+        if (k < delay) {
+          EXPECT_EQ(raw, intent(k)) << "delay " << delay << " step " << k;
+          EXPECT_GT((exec - intent(k)).cwiseAbs().maxCoeff(), 1e-3) << "the contract must mis-map the intent";
+        } else {
+          EXPECT_LT((exec - intent(k)).cwiseAbs().maxCoeff(), 1e-12) << "delay " << delay << " step " << k;
+        }
+      }
+    }
+  }
+}
+
+TEST(DelayedOracle, HoldSendsAZeroPoseWithTheIntentsGripperThroughTheTruth) {
+  const Contract truth = reference::representative_contracts("unseen_composition")[0];
+  DelayedOracleAdapter o(truth, 3, DelayedOracleAdapter::Before::kHold);
+  Decoder env(truth);
+  o.begin_episode(0);
+  Rng rng(5);
+  for (int k = 0; k < 8; ++k) {
+    const Mat3 R = actionshift::testing::random_rotation(rng);
+    const Action raw = o.encode(intent(k), R);
+    const Action exec = env.step(raw, R);
+    o.observe(raw, Pose6::Zero(), R);
+    Action want = intent(k);
+    if (k < 3) want.head<kPoseDim>().setZero();
+    EXPECT_LT((exec - want).cwiseAbs().maxCoeff(), 1e-12) << "step " << k;
+    EXPECT_FALSE(o.last_step().probe);
+  }
+}
+
 }  // namespace
 }  // namespace actionshift::adapt

@@ -2,6 +2,7 @@
 // issue): the registry's defaults of entropy_probes and dualabi are the reference's selection rule, the
 // project's corrections are the named variant `calibrated`, and labels round-trip canonically.
 #include "actionshift/adapt/methods.hpp"
+#include "actionshift/adapt/plugin.hpp"
 #include "actionshift/adapt/registry.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/reference_contracts.hpp"
@@ -90,6 +91,25 @@ TEST(MakeAdapter, UnresolvedParametersTakeDefaultsAndBadOnesAreOneLineErrors) {
   EXPECT_THAT([&] { make_adapter("entropy_probes", {{"budgte", 6}}, in); }, one_line("budgte: unknown parameter"));
   EXPECT_THAT([&] { make_adapter("dualabi", {{"tau", 1.5}}, MethodInputs{}); },
               ThrowsMessage<InputError>(HasSubstr("needs a pool")));
+}
+
+TEST(MakeAdapter, TheDelayedOracleIsOnTheOracleRungAndChecksItsParameters) {
+  // a diagnostic beside the paper's methods: the truth is its privilege, as the oracle's, and nothing else
+  EXPECT_EQ(method_rung("delayed_oracle"), Rung::oracle);
+  EXPECT_FALSE(method_needs_pool("delayed_oracle"));
+  EXPECT_FALSE(method_needs_calibration("delayed_oracle"));
+  EXPECT_EQ(resolve_method_params("delayed_oracle"), (nlohmann::json{{"delay", 6}, {"before", "no_adapt"}}));
+  const Contract truth = reference::representative_contracts("seen")[1];
+  MethodInputs in;
+  in.truth = &truth;
+  EXPECT_EQ(make_adapter("delayed_oracle", {{"delay", 2}, {"before", "hold"}}, in)->name(), "delayed_oracle");
+  auto one_line = [](const std::string& what) {
+    return ThrowsMessage<InputError>(::testing::AllOf(HasSubstr(what), ::testing::Not(HasSubstr("\n"))));
+  };
+  EXPECT_THAT([&] { make_adapter("delayed_oracle", nlohmann::json::object(), MethodInputs{}); }, one_line("needs the true contract"));
+  EXPECT_THAT([&] { make_adapter("delayed_oracle", {{"delay", -1}}, in); }, one_line("method delayed_oracle: delay: must be in"));
+  EXPECT_THAT([&] { make_adapter("delayed_oracle", {{"before", "probe"}}, in); },
+              one_line("method delayed_oracle: before: must be one of no_adapt, hold"));
 }
 
 TEST(MethodLabels, CanonicalLabelsRoundTrip) {

@@ -9,7 +9,7 @@ TASK = "pick_cube"
 
 def adapter_for(method, truth):
     pool = "reference9" if actionshift.method_needs_pool(method) else None
-    return actionshift.make_adapter(method, task=TASK, pool=pool, truth=truth if method == "oracle" else None)
+    return actionshift.make_adapter(method, task=TASK, pool=pool, truth=truth if method in ("oracle", "delayed_oracle") else None)
 
 
 def run_episode(env, adapter, seed, steps, intent):
@@ -31,7 +31,8 @@ def run_episode(env, adapter, seed, steps, intent):
 def test_every_registered_method_builds_and_runs():
     names = actionshift.methods()
     assert set(names) == {"oracle", "no_adapt", "exact_belief", "fixed_probes", "random_probes",
-                          "entropy_probes", "dualabi", "grammar_belief", "osi", "probe_osi", "recurrent_osi"}
+                          "entropy_probes", "dualabi", "grammar_belief", "osi", "probe_osi", "recurrent_osi",
+                          "delayed_oracle"}
     truth = actionshift.load_manifest("reference9").contracts[1]
     env = actionshift.make(TASK, contract=truth)
     intent = np.array([0.2, 0.0, -0.1, 0.0, 0.0, 0.0, 1.0])
@@ -42,7 +43,7 @@ def test_every_registered_method_builds_and_runs():
         expected_probes = {"fixed_probes": 6, "random_probes": 6, "entropy_probes": 6, "probe_osi": 6}.get(method)
         if expected_probes is not None:
             assert probes == expected_probes, method
-        elif method in ("oracle", "no_adapt", "exact_belief", "grammar_belief", "osi", "recurrent_osi"):
+        elif method in ("oracle", "delayed_oracle", "no_adapt", "exact_belief", "grammar_belief", "osi", "recurrent_osi"):
             assert probes == 0, method
 
 

@@ -48,6 +48,39 @@ class OracleAdapter final : public Adapter {
   Decoder replica_;
 };
 
+/// A diagnostic, not a method of the paper: the oracle after `delay` steps without it. For the first
+/// `delay` steps of an episode it sends either the backbone's canonical action unchanged (`kNoAdapt`: what
+/// a passive adapter sends before its belief names the contract) or, through the true contract, a zero
+/// pose command with the backbone's gripper (`kHold`: the arm stays where it is while the backbone's
+/// intents are dropped, as during a probing adapter's probes, without the probes' motion); from then on
+/// it is the oracle. Its replica of the decoder follows every step, so the oracle part tracks the same
+/// target as the environment. It measures what the first steps of an episode cost a backbone by
+/// themselves, whatever an adapter then identifies. Privilege: the true contract, as the oracle.
+class DelayedOracleAdapter final : public Adapter {
+ public:
+  enum class Before { kNoAdapt, kHold };
+  DelayedOracleAdapter(const Contract& truth, int delay, Before before) : replica_(truth), delay_(delay), before_(before) {}
+  std::string name() const override { return "delayed_oracle"; }
+  void begin_episode(std::uint64_t) override {
+    replica_.reset_all();
+    steps_ = 0;
+  }
+  Action encode(const Action& canonical, const Mat3& R) override {
+    if (steps_++ >= delay_) return actionshift::encode(replica_.contract(), canonical, R, replica_.tracked_target());
+    if (before_ == Before::kNoAdapt) return canonical;
+    Action hold = Action::Zero();
+    hold[kPoseDim] = canonical[kPoseDim];
+    return actionshift::encode(replica_.contract(), hold, R, replica_.tracked_target());
+  }
+  void observe(const Action& raw, const Pose6&, const Mat3& R) override { replica_.step(raw, R); }
+
+ private:
+  Decoder replica_;
+  int delay_;
+  Before before_;
+  int steps_{0};
+};
+
 /// Options shared by the probing adapters.
 struct ProbeOptions {
   int budget{6};              ///< probe steps per episode (reference default 6)
