@@ -226,6 +226,8 @@ std::vector<ScriptSeed> scan_script(const fs::path& file) {
   static const std::regex cli(R"re(--seed(?:\s+|=|["']\s*,\s*)["']?(\d+)\b)re");
   static const std::regex assign(R"re(\b[A-Za-z_]*(?:seeds?|SEEDS?)\s*=\s*(\[[^\]]*\]|"[^"]*"|'[^']*'|\d+))re");
   static const std::regex loop(R"re(\bfor\s+\w*(?:seed|SEED)\w*\s+in\s+(\d[\d\s]*);)re");
+  // a shell default, SEEDS="${SEEDS:-20260718 20260719}": the seeds a script runs when the caller sets none
+  static const std::regex shell_default(R"re(\$\{\w*(?:seed|SEED)\w*:-["']?(\d[\d\s]*)["']?\})re");
   static const std::regex yaml_seeds(R"re(\bseeds:\s*\[([\d,\s]+)\])re");
   static const std::regex rng(R"re(\b(?:Random|default_rng|RandomState|manual_seed|seed)\((\d+)\))re");
   static const std::regex argparse_default(R"re(default\s*=\s*(\d+))re");
@@ -243,7 +245,7 @@ std::vector<ScriptSeed> scan_script(const fs::path& file) {
       add_numbers((*it)[1].str(), line_no, out);
     for (auto it = std::sregex_iterator(line.begin(), line.end(), assign); it != std::sregex_iterator(); ++it)
       if (std::regex_match((*it)[1].str(), digits_only)) add_numbers((*it)[1].str(), line_no, out);
-    for (const auto* re : {&loop, &yaml_seeds, &rng})
+    for (const auto* re : {&loop, &yaml_seeds, &rng, &shell_default})
       for (auto it = std::sregex_iterator(line.begin(), line.end(), *re); it != std::sregex_iterator(); ++it)
         add_numbers((*it)[1].str(), line_no, out);
     if (line.find("--seed") != std::string::npos && std::regex_search(line, m, argparse_default))
@@ -482,13 +484,14 @@ TEST(SeedRegistry, ScriptScannerFindsEachDocumentedPatternAndIgnoresComments) {
                       "def f(seed=913, rng_seed=seed): pass\n"
                       "DESIGN_SEEDS = [914, 915]\n"
                       "subprocess.run([AS, \"--seed\", \"916\"])\n"
-                      "seed=$4; SEEDS=\"$X\"; episodes=917; seeds_text = 918\n";
+                      "seed=$4; SEEDS=\"$X\"; episodes=917; seeds_text = 918\n"
+                      "SEEDS=\"${SEEDS:-919 920}\"; SEED=${SEED:-921}; EPISODES=${EPISODES:-922}\n";
   std::set<std::uint64_t> found;
   for (const auto& s : scan_script(f)) found.insert(s.seed);
   fs::remove_all(dir);
   std::set<std::uint64_t> want;
-  for (std::uint64_t s = 901; s <= 916; ++s)
-    if (s != 902) want.insert(s);
+  for (std::uint64_t s = 901; s <= 921; ++s)
+    if (s != 902 && s != 917 && s != 918) want.insert(s);
   EXPECT_EQ(found, want);
 }
 

@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 AS="$(realpath "$1")"; shift
-PAGES="${*:-brittleness long_lag noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance}"
+PAGES="${*:-brittleness long_lag noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance delayed_oracle}"
 D=tests/pages/data
 S=20260718
 N=4
@@ -44,6 +44,14 @@ for page in $PAGES; do
         dp_bench.json env_bench.jsonl pick_cube.dp.asdp) \
         > "$D/$page/results/dp_cost.json"
     rm -rf "$bdir" ;;
+  delayed_oracle)
+    # the expert and the DAgger MLP (the page's layout, not the Diffusion Policy's cost), every method of scripts/delayed_oracle
+    for b in expert mlp; do
+      for m in oracle 'delayed_oracle' 'delayed_oracle{delay=1}' 'delayed_oracle{before=hold}'; do
+        run --task pick_cube --split reference_seen --method "$m" --backbone "$b" --out "$D/$page/results"
+      done
+      run --task pick_cube --split reference_seen --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
+    done ;;
   backbone_variance)
     # three backbones of push_cube (the committed PPO and the two replicas), two seeds, every method of the pairs
     for b in ppo mlp:configs/backbones/replicas/push_cube.ppo.seed20260801.asmlp mlp:configs/backbones/replicas/push_cube.ppo.seed20260802.asmlp; do

@@ -1,10 +1,10 @@
-# Golden tests of the long-lag, brittleness, noise-sensitivity, Gate 0, identifiers, DualABI-pilot, ladder,
+# Golden tests of the long-lag, delayed-oracle, brittleness, noise-sensitivity, Gate 0, identifiers, DualABI-pilot, ladder,
 # backbone-variance and audit pages (included by tests/pages/CMakeLists.txt): each runs `actionshift compare` on a committed fixture and the
 # page script, and compares with tests/pages/golden/<page>.md (the ladder: one compare per group of
 # scripts/ladder_groups.py, pairs from the fixture's ladder*.pairs).
 find_package(Python3 COMPONENTS Interpreter)
 if(Python3_Interpreter_FOUND)
-  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance audit)
+  foreach(page long_lag brittleness noise_sensitivity gate0 identifiers dualabi_pilot ladder backbone_variance audit delayed_oracle)
     add_test(NAME pages.${page}
              COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/run_page_test.py ${page} $<TARGET_FILE:actionshift>)
     set_tests_properties(pages.${page} PROPERTIES LABELS pages TIMEOUT 120)
@@ -23,6 +23,10 @@ if(Python3_Interpreter_FOUND)
   set_tests_properties(pages.long_lag_verdict PROPERTIES LABELS pages TIMEOUT 60)
 endif()
 if(Python3_Interpreter_FOUND)
+  # the delayed-oracle page's rule on "the adapters restore the backbone to its oracle", every branch on made-up differences
+  add_test(NAME pages.delayed_oracle_verdict
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/delayed_oracle_verdict_test.py)
+  set_tests_properties(pages.delayed_oracle_verdict PROPERTIES LABELS pages TIMEOUT 60)
   # the wall-time clause of every page header: jobs an earlier invocation ran are named, not counted as this run's time
   add_test(NAME pages.wall_text COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/wall_text_test.py)
   set_tests_properties(pages.wall_text PROPERTIES LABELS pages TIMEOUT 60)

@@ -31,6 +31,10 @@ def page_text(page, binary, tmp):
         compare(binary, [f"{d}/results"], f"{tmp}/c.json", "scripts/brittleness.pairs")
         return py("scripts/brittleness_report.py", f"{tmp}/c.json", f"{d}/results", *PROV,
                   "--command", f"THREADS=1 EPISODES=4 scripts/brittleness {d}/results")
+    if page == "delayed_oracle":
+        compare(binary, [f"{d}/results"], f"{tmp}/c.json", "scripts/delayed_oracle.pairs")
+        return py("scripts/delayed_oracle_report.py", f"{tmp}/c.json", *PROV, "--reused", "0",
+                  "--command", f"THREADS=1 EPISODES=4 scripts/delayed_oracle {d}/results")
     if page == "backbone_variance":
         compare(binary, [f"{d}/results"], f"{tmp}/c.json", "scripts/backbone_variance.pairs", ["--across-backbones"])
         return py("scripts/backbone_variance_report.py", f"{tmp}/c.json", "--commit", "0000000", "--wall", "12",

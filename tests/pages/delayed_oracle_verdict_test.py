@@ -1,0 +1,51 @@
+#!/usr/bin/env python3
+"""Unit check of the delayed-oracle page's rule on "the same adapters restore the backbone to its oracle"
+(scripts/delayed_oracle_report.py, rule): every branch, on hand-made comparison objects (made-up differences in
+compare's `difference` shape; the golden fixture's tiny runs reach only the `reproduced` branch). Each case names
+the status the rule gives and a phrase of its reason.
+usage: tests/pages/delayed_oracle_verdict_test.py"""
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from delayed_oracle_report import rule  # noqa: E402
+
+
+def cmp(est, lo, hi):
+    return {"difference": {"estimate": est, "lower": lo, "upper": hi, "excludes_zero": lo > 0 or hi < 0}}
+
+
+GAP = cmp(0.40, 0.30, 0.50)  # oracle well above the adapter
+ZERO = cmp(0.0, -0.05, 0.05)
+# (gap, [(label, oracle - label, label - exact_belief)], status, a phrase of the reason)
+CASES = [
+    (cmp(0.02, -0.03, 0.07), [], "reproduced", "includes 0"),
+    (cmp(-0.10, -0.15, -0.05), [], "contradicted", "above its oracle"),
+    (None, [], "untestable", "not run"),
+    (GAP, [("delayed_oracle", cmp(0.38, 0.28, 0.48), ZERO)], "contradicted", "the delay accounts for the adapter's loss"),
+    (GAP, [("delayed_oracle", cmp(0.20, 0.10, 0.30), cmp(0.20, 0.10, 0.30))], "contradicted",
+     "accounts for part of the loss"),
+    (GAP, [("delayed_oracle", ZERO, cmp(0.40, 0.30, 0.50)), ("delayed_oracle{delay=1}", None, None)], "contradicted",
+     "the cause is not found here"),
+    # a delay that makes the oracle better is no cost
+    (GAP, [("delayed_oracle", cmp(-0.2, -0.3, -0.1), cmp(0.6, 0.5, 0.7))], "contradicted", "the cause is not found here"),
+    # the whole and a part: the whole is named first
+    (GAP, [("delayed_oracle{delay=1}", cmp(0.1, 0.02, 0.18), cmp(0.3, 0.2, 0.4)), ("delayed_oracle", cmp(0.38, 0.28, 0.48), ZERO)],
+     "contradicted", "measured reason: the first steps without the contract, which the backbone does not recover from: `delayed_oracle` costs"),
+]
+
+
+def main():
+    bad = 0
+    for gap, delayed, want, phrase in CASES:
+        st, why = rule(gap, delayed)
+        if st != want or phrase not in why:
+            print(f"FAIL: want {want} with {phrase!r}, got {st}: {why}")
+            bad += 1
+    print(f"{len(CASES) - bad}/{len(CASES)} cases")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
