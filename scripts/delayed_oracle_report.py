@@ -12,6 +12,7 @@ includes 0 accounts for the adapter's loss (the backbone cannot afford those fir
 after them); a delay whose cost excludes 0 but which stays above the adapter accounts for part of it; no delay
 whose cost excludes 0 means the first steps are not the reason, and the page says the cause is not found.
 usage: scripts/delayed_oracle_report.py COMPARE_JSON [--commit C --command CMD --wall S --cores N --cpu TIMES --reused N]"""
+import json
 import os
 import sys
 
@@ -57,14 +58,38 @@ def rule(gap, delayed):
     for label, cost, rest in delayed:
         if not positive(cost):
             continue
-        text = f"`{label}` costs the oracle {fmt.diff(cost['difference'])}, and {label} − exact_belief is {fmt.diff(rest['difference']) if rest else fmt.DASH}"
-        (whole if includes_zero(rest) else part).append(text)
+        text = (f"`{label}` costs the oracle {fmt.diff(cost['difference'])} and {label} − exact_belief is "
+                f"{fmt.diff(rest['difference']) if rest else fmt.DASH}")
+        if includes_zero(rest):
+            whole.append(text + ", which includes 0")
+        else:
+            part.append(text + (", which excludes 0" if rest else ""))
     head = f"exact_belief is below its oracle (oracle − exact_belief {fmt.diff(gap['difference'])}); "
     if whole:
-        return "contradicted", head + "measured reason: the first steps without the contract, which the backbone does not recover from: " + "; ".join(whole + part) + " (includes 0: the delay accounts for the adapter's loss)"
+        return "contradicted", (head + "measured reason: the first steps without the contract, which the backbone does not recover "
+                                "from; a delay whose difference from exact_belief includes 0 accounts for the adapter's loss: "
+                                + "; ".join(whole + part))
     if part:
-        return "contradicted", head + "measured reason, in part: the first steps without the contract: " + "; ".join(part) + " (excludes 0: the delay accounts for part of the loss)"
+        return "contradicted", (head + "measured reason, in part: the first steps without the contract; each delay below costs the "
+                                "oracle but stays above exact_belief, so it accounts for part of the loss: " + "; ".join(part))
     return "contradicted", head + "no delay tried costs the oracle a difference that excludes 0, so the first steps are not the reason; the cause is not found here"
+
+
+def jobs_wall(C):
+    """`dp 43.2 min, mlp 10 s`: the jobs' own wall time per backbone, from their summaries' `wall_time_s` (each job's
+    last run: a page re-made over finished jobs still says what they cost)."""
+    sec = {}
+    for c in C.cells:
+        for j in c["jobs"]:
+            for d in C.input_dirs():
+                path = os.path.join(d, j + ".summary.json")
+                if os.path.exists(path):
+                    with open(path) as f:
+                        v = json.load(f).get("wall_time_s")
+                    if v is not None:
+                        sec[c["backbone"]] = sec.get(c["backbone"], 0.0) + v
+                    break
+    return ", ".join(f"`{b}` {t / 60:.1f} min" if t >= 120 else f"`{b}` {t:.0f} s" for b, t in sec.items())
 
 
 def main():
@@ -79,11 +104,12 @@ def main():
         episodes_per_seed=C.episodes_per_seed(), wall=a.wall, cores=a.cores, reused=a.reused,
         paper_source=C.paper_source(), bootstrap=C.bootstrap(),
         extra=[f"Task `{TASK}`, split `{SPLIT}` (the paper's two seen contracts); `dp` at horizon 100 as the reference "
-               "evaluates it, the others at the task's 50" + cpu_text(a.cpu) + "."])]
+               "evaluates it, the others at the task's 50" + cpu_text(a.cpu) + ".",
+               f"The jobs' own wall time (their summaries' `wall_time_s`, whichever run of the command ran them): {jobs_wall(C) or fmt.DASH}."])]
     w = out.append
     w("The paper says (§5.8) that the same policy-agnostic adapters restore its frozen Diffusion Policy to its oracle\n"
-      "ceiling. On the brittleness page (docs/results/brittleness.md) ours restore the Diffusion Policy trained here to\n"
-      "about half of its oracle, while the same adapters restore the DAgger MLP to its oracle. An adapter spends an\n"
+      "ceiling. On the brittleness page (docs/results/brittleness.md, its `dp` rows) ours restore the Diffusion Policy\n"
+      "trained here to well below its oracle, while the same adapters restore the DAgger MLP to its oracle. An adapter spends an\n"
       "episode's first steps before it knows the contract: a passive one sends the backbone's intents through a map it\n"
       "is not yet sure of, a probing one sends probes while the backbone's intents are dropped. `delayed_oracle` (a\n"
       "diagnostic on the oracle rung, docs/adapters.md) measures what those first steps cost a backbone by themselves:\n"
@@ -102,6 +128,12 @@ def main():
     w("## Every cell\n\n")
     w(table.markdown(["backbone", "paradigm", "method", "what ran", "success [Wilson 95 %]", "per seed", "probe steps",
                       "flagged episodes", "paper", "paper's backbone"], rows))
+    po = paper.cell_entry(C.cell(TASK, SPLIT, "oracle", "dp") or {})
+    pe = paper.cell_entry(C.cell(TASK, SPLIT, "exact_belief", "dp") or {})
+    if po and pe:
+        w(f"\nIn the paper's own cells (the paper column) its Diffusion Policy's exact belief succeeds {fmt.num(pe['value'])} of\n"
+          f"the time and its oracle {fmt.num(po['value'])}: its adapter is not below its oracle, which is the claim. Ours: "
+          f"{fmt.cell_rate(C.cell(TASK, SPLIT, 'exact_belief', 'dp'))} against {fmt.cell_rate(C.cell(TASK, SPLIT, 'oracle', 'dp'))}.\n")
     w("\n## What the first steps cost, and what the adapter loses\n\n")
     w("Paired differences (bootstrap over seed, contract and episode) from compare, candidate − baseline.\n\n")
     rows = []

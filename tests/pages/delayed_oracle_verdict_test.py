@@ -23,7 +23,7 @@ CASES = [
     (cmp(0.02, -0.03, 0.07), [], "reproduced", "includes 0"),
     (cmp(-0.10, -0.15, -0.05), [], "contradicted", "above its oracle"),
     (None, [], "untestable", "not run"),
-    (GAP, [("delayed_oracle", cmp(0.38, 0.28, 0.48), ZERO)], "contradicted", "the delay accounts for the adapter's loss"),
+    (GAP, [("delayed_oracle", cmp(0.38, 0.28, 0.48), ZERO)], "contradicted", "accounts for the adapter's loss: `delayed_oracle` costs"),
     (GAP, [("delayed_oracle", cmp(0.20, 0.10, 0.30), cmp(0.20, 0.10, 0.30))], "contradicted",
      "accounts for part of the loss"),
     (GAP, [("delayed_oracle", ZERO, cmp(0.40, 0.30, 0.50)), ("delayed_oracle{delay=1}", None, None)], "contradicted",
@@ -32,7 +32,7 @@ CASES = [
     (GAP, [("delayed_oracle", cmp(-0.2, -0.3, -0.1), cmp(0.6, 0.5, 0.7))], "contradicted", "the cause is not found here"),
     # the whole and a part: the whole is named first
     (GAP, [("delayed_oracle{delay=1}", cmp(0.1, 0.02, 0.18), cmp(0.3, 0.2, 0.4)), ("delayed_oracle", cmp(0.38, 0.28, 0.48), ZERO)],
-     "contradicted", "measured reason: the first steps without the contract, which the backbone does not recover from: `delayed_oracle` costs"),
+     "contradicted", "accounts for the adapter's loss: `delayed_oracle` costs the oracle +0.380 [+0.280, +0.480] and delayed_oracle − exact_belief is +0.000 [-0.050, +0.050], which includes 0; `delayed_oracle{delay=1}`"),
 ]
 
 
