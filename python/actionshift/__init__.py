@@ -450,7 +450,7 @@ def make_adapter(method, task="pick_cube", pool=None, truth=None, params=None, c
     ``method_variants()``; a bare name is the paper's method): ``begin_episode(seed)``, ``encode(canonical, R)``
     -> raw action, ``observe(raw, response, R)``. Belief methods use the task's built-in response
     calibration; pool methods need ``pool`` (a pool name such as ``"reference9"``, a manifest path,
-    or a list of contracts); the oracle needs ``truth``. ``params``: method parameters (dict).
+    or a list of contracts); the oracle (and its diagnostic ``delayed_oracle``) needs ``truth``. ``params``: method parameters (dict).
     ``calibration``: a response calibration (a dict as ``actionshift calibrate --json`` writes it, or
     its file) instead of the task's built-in one, for belief methods only."""
     return _native._make_adapter(method, task, pool, truth, params, calibration)
