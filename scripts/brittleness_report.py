@@ -97,6 +97,24 @@ def dp_probe_status(cell):
     return "contradicted", f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes, against the paper's 0.0"
 
 
+def own_runs_text(task, threads, ds, dn, step_ms, os_, on):
+    """The page's own `dp` jobs (ds seconds of wall time, dn control steps, `threads` threads each) beside the
+    benchmark's one-thread step_ms: like with like, the benchmark's CPU time and, spread over the job's threads,
+    the wall time it would take if they never waited, against the measured wall time; then the other backbones'."""
+    cpu = dn * step_ms / 1000
+    text = (f"In this page's own runs ({threads} thread(s) per job; the jobs' `wall_time_s` and steps from their"
+            f" summaries) the `dp` jobs of {task} took {duration(ds)} of wall time for {fmt.thousands(int(dn))} control"
+            f" steps ({1000 * ds / dn:.2f} ms per step). At the benchmark's one-thread {step_ms:.2f} ms per step the"
+            f" policy alone is {duration(cpu)} of CPU time")
+    if str(threads).isdigit() and int(threads) > 1:
+        text += f", {duration(cpu / int(threads))} of wall time if the job's {threads} threads never wait"
+    text += f", against the {duration(ds)} measured"
+    if on:
+        text += (f"; the other backbones' jobs took {duration(os_)} for {fmt.thousands(int(on))} steps"
+                 f" ({1000 * os_ / on:.3f} ms per step, adapters and simulation included)")
+    return text + "."
+
+
 def dp_cost_section(path, C, summaries, threads):
     """The Diffusion Policy's inference cost against the simulator step it drives, from dp_cost.json."""
     if not os.path.exists(path):
@@ -133,14 +151,7 @@ def dp_cost_section(path, C, summaries, threads):
         ds, dn = jobs_wall_per_step(C, summaries, t["task"], True)
         os_, on = jobs_wall_per_step(C, summaries, t["task"], False)
         if dn:
-            text = (f"In this page's own runs ({threads} thread(s) per job; the jobs' `wall_time_s` and steps from their"
-                    f" summaries) the `dp` jobs of {t['task']} took {duration(ds)} for {fmt.thousands(int(dn))} control steps"
-                    f" ({1000 * ds / dn:.2f} ms per step), of which the benchmark's figure accounts for about"
-                    f" {duration(dn * t['control_step_ms'] / 1000)}")
-            if on:
-                text += (f"; the other backbones' jobs took {duration(os_)} for {fmt.thousands(int(on))} steps"
-                         f" ({1000 * os_ / on:.3f} ms per step, adapters and simulation included)")
-            out.append(text + ".\n")
+            out.append(own_runs_text(t["task"], threads, ds, dn, t["control_step_ms"], os_, on) + "\n")
     out.append("")
     return out
 
@@ -246,6 +257,10 @@ def main():
     w(table.markdown(["task", "ours: `dualabi` probe steps (seen)", "paper", "status", "reason"], rows)
       if rows else "No `dp` backbone ran here: no Diffusion Policy weight file is adopted yet (docs/backbones.md).\n")
     w("")
+    if rows:
+        w("How far the adapters restore the `dp` against its own oracle, and how much of any gap its first steps"
+          " without the contract explain (an oracle that starts late, before any adapter could know the contract), is"
+          " measured on docs/results/delayed_oracle.md (`scripts/delayed_oracle`).\n")
     w("The paper's scalars (configs/paper/numbers.json by id):\n")
     rows = [[f"`{i}`", (numbers.by_id(i) or {}).get("quantity", fmt.DASH), scalar(numbers, i),
              (numbers.by_id(i) or {}).get("note", "")] for i in DP_IDS]
