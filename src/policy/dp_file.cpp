@@ -152,6 +152,7 @@ DpPolicy::DpPolicy(std::shared_ptr<const DpWeights> weights, std::string sha256,
       net_(std::make_shared<const DpUnet<float>>(weights_->arch)),
       ws_(net_->workspace()),
       schedule_(DdpmSchedule::squaredcos_cap_v2(weights_->arch.diffusion_steps)) {
+  dp_fix_eigen_l1();  // before the worker threads that clone this policy start sampling
   if (static_cast<std::int64_t>(weights_->params.size()) != net_->parameter_count())
     throw std::invalid_argument("DpPolicy: weights do not match the architecture");
 }
@@ -174,6 +175,7 @@ void DpPolicy::plan() {
   cond_.resize(a.obs_horizon * a.obs_dim);
   for (int i = 0; i < a.obs_horizon; ++i) cond_.segment(i * a.obs_dim, a.obs_dim) = frames_[static_cast<std::size_t>(i)];
   Rng rng(derive_seed({kPolicyNoiseStream, episode_seed_, chunk_index_++}));
+  dp_fix_eigen_l1();  // a no-op unless something changed Eigen's setting since construction
   chunk_ = dp_sample(*net_, weights_->params.data(), schedule_, cond_, rng, *ws_, weights_->ddim_steps);
   next_ = 0;
   ++chunks_;

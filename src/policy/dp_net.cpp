@@ -310,4 +310,8 @@ template class DpUnet<double>;
 
 std::int64_t dp_parameter_count(const DpArch& arch) { return DpUnet<float>(arch).parameter_count(); }
 
+void dp_fix_eigen_l1() {
+  if (Eigen::l1CacheSize() != kDpEigenL1Bytes) Eigen::setCpuCacheSizes(kDpEigenL1Bytes, Eigen::l2CacheSize(), Eigen::l3CacheSize());
+}
+
 }  // namespace actionshift::policy

@@ -30,16 +30,12 @@ struct Demo {
 };
 
 // Eigen blocks the depth of a matrix product by a length it derives from the L1 data cache size
-// (Eigen::l1CacheSize(), read from the CPU), and a product blocked differently rounds differently:
-// the U-Net's deepest layers (depth 1,280 and 2,560) are blocked, so without this the trained bytes
-// would depend on the machine. train_dp fixes the L1 size Eigen assumes to 32 KiB while it runs:
-// configs/backbones/pick_cube.dp.asdp was trained under 32 KiB (its curve's first loss, iteration 50,
-// is reproduced to the last bit with 32 KiB and differs in the ninth digit with 48 KiB). Only the
-// blocking changes, not the result's meaning.
-constexpr std::ptrdiff_t kTrainL1Bytes = 32 * 1024;
+// (kDpEigenL1Bytes in dp.hpp): train_dp fixes it to 32 KiB while it runs, as DpPolicy does for
+// sampling. configs/backbones/pick_cube.dp.asdp was trained under 32 KiB (its curve's first loss,
+// iteration 50, is reproduced to the last bit with 32 KiB and differs in the ninth digit with 48 KiB).
 struct EigenL1Pin {
   std::ptrdiff_t l1{Eigen::l1CacheSize()}, l2{Eigen::l2CacheSize()}, l3{Eigen::l3CacheSize()};
-  EigenL1Pin() { Eigen::setCpuCacheSizes(kTrainL1Bytes, l2, l3); }
+  EigenL1Pin() { Eigen::setCpuCacheSizes(kDpEigenL1Bytes, l2, l3); }
   ~EigenL1Pin() { Eigen::setCpuCacheSizes(l1, l2, l3); }
   EigenL1Pin(const EigenL1Pin&) = delete;
   EigenL1Pin& operator=(const EigenL1Pin&) = delete;

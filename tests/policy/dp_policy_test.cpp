@@ -3,6 +3,7 @@
 // frame, receding-horizon chunks, determinism, the `dp:<path>` backbone)
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/hash.hpp"
+#include "actionshift/core/rng.hpp"
 #include "actionshift/core/weight_file.hpp"
 #include "actionshift/policy/dp.hpp"
 #include "actionshift/policy/registry.hpp"
@@ -218,6 +219,51 @@ TEST_F(DpPolicyTest, OpenLoopWithinAChunkAndDeterministic) {
   a.reset();
   EXPECT_NE(a.act(obs_at(0, 0.01)), first[0]);
   EXPECT_THROW(a.act(Eigen::VectorXd::Zero(5)), std::invalid_argument);
+}
+
+// Eigen blocks a product's depth by a length it derives from the L1 cache size it reads from the CPU,
+// so the same weights and episode sampled other actions on a machine with another L1 (the brittleness
+// page's clean Diffusion Policy run went 39/50 where it was first run and 37/50 on a 48 KiB machine):
+// the policy fixes the size for its products, whatever the machine's, and keeps it fixed if something
+// changes it between chunks. The raw sampler shows that the two sizes do block this network differently.
+TEST(DpPolicyL1, ActionsDoNotDependOnTheMachinesL1Cache) {
+  const std::ptrdiff_t l1 = Eigen::l1CacheSize(), l2 = Eigen::l2CacheSize(), l3 = Eigen::l3CacheSize();
+  DpWeights w = small_weights();  // DDPM, 20 steps
+  w.arch.down_dims = {8, 240};    // depth 240 x 3 = 720: blocked under a 32 KiB L1 (680), not under 48 KiB (1,016)
+  w.params = DpUnet<float>(w.arch).init(4);
+  const auto shared = std::make_shared<const DpWeights>(w);
+  const std::ptrdiff_t k32 = 32 * 1024, k48 = 48 * 1024, k64 = 64 * 1024;
+  ASSERT_EQ(kDpEigenL1Bytes, k32);
+  std::vector<std::vector<Action>> runs;
+  for (const std::ptrdiff_t cache : {k48, k32, k64}) {
+    Eigen::setCpuCacheSizes(cache, l2, l3);  // a machine with this L1
+    DpPolicy p(shared, std::string(64, '0'), "dp:x");
+    p.reset();
+    std::vector<Action> actions;
+    for (int k = 0; k < 10; ++k) {  // three chunks of 4
+      if (k == 5) Eigen::setCpuCacheSizes(cache, l2, l3);  // changed again between chunks
+      actions.push_back(p.act(obs_at(k)));
+    }
+    EXPECT_EQ(Eigen::l1CacheSize(), kDpEigenL1Bytes) << "L1 " << cache;
+    EXPECT_EQ(Eigen::l2CacheSize(), l2) << "L1 " << cache << ": the L2 size is the machine's";
+    runs.push_back(std::move(actions));
+  }
+  for (std::size_t r = 1; r < runs.size(); ++r)
+    for (std::size_t k = 0; k < runs[0].size(); ++k) EXPECT_EQ(runs[r][k], runs[0][k]) << "run " << r << ", step " << k;
+
+  const DpUnet<float> net(w.arch);
+  const auto ws = net.workspace();
+  const DdpmSchedule schedule = DdpmSchedule::squaredcos_cap_v2(w.arch.diffusion_steps);
+  const DpVec<float> cond = DpVec<float>::LinSpaced(w.arch.obs_horizon * w.arch.obs_dim, -1.0f, 1.0f);
+  std::vector<DpMat<float>> raw;
+  for (const std::ptrdiff_t cache : {k32, k48}) {
+    Eigen::setCpuCacheSizes(cache, l2, l3);
+    Rng rng(7);
+    raw.push_back(dp_sample(net, w.params.data(), schedule, cond, rng, *ws, 0));
+  }
+  EXPECT_NE(std::memcmp(raw[0].data(), raw[1].data(), sizeof(float) * static_cast<std::size_t>(raw[0].size())), 0)
+      << "the two cache sizes should block this network's products differently";
+  Eigen::setCpuCacheSizes(l1, l2, l3);
 }
 
 TEST_F(DpPolicyTest, RegistryLoadsDpPath) {

@@ -245,6 +245,23 @@ void save_dp(const DpWeights& w, const std::string& path);
 /// Read and parse a weight file. Throws actionshift::InputError.
 DpWeights load_dp(const std::string& path);
 
+// ---- machine-independent products ----------------------------------------------------------------
+
+/// The L1 data-cache size every Diffusion Policy product runs under, whatever the CPU: 32 KiB.
+/// Eigen blocks the depth of a matrix product by a length it derives from the L1 size it reads from
+/// the CPU, and a product blocked differently rounds differently; the U-Net's deepest products (depth
+/// 1,280 and 2,560 in the paper's network) are blocked. So without a fixed size the same weights and
+/// episode give other actions, and other outcomes, on a machine with another L1 (48 KiB here against
+/// 32 KiB where the committed files were trained and first evaluated). Only the blocking changes.
+inline constexpr std::ptrdiff_t kDpEigenL1Bytes = 32 * 1024;
+
+/// Set the L1 size Eigen assumes to kDpEigenL1Bytes (keeping its L2 and L3 sizes) unless it already
+/// is. Eigen keeps one such setting per process: DpPolicy calls this on construction and before every
+/// chunk it samples and does not undo it, so any other Eigen product of the process that is deep
+/// enough to be blocked runs under 32 KiB from then on too. train_dp sets it for its own duration and
+/// then gives the caller's setting back.
+void dp_fix_eigen_l1();
+
 // ---- policy --------------------------------------------------------------------------------------
 
 /// The Diffusion Policy as a Policy: the last obs_horizon observations (at reset the stack is
