@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes docs/results/delayed_oracle.md (scripts/delayed_oracle): the oracle, the oracle delayed by an episode's
-first steps (`delayed_oracle`, docs/adapters.md) and the passive exact belief, per backbone on pick_cube's seen
+first steps (`delayed_oracle`, docs/adapters.md) and the passive exact belief, per task and backbone on the task's seen
 reference contracts, and the status of the paper's "the same adapters restore the Diffusion Policy to its oracle
 ceiling" (§5.8) with the measured reason. Layout only: every rate, interval and difference is from `actionshift
 compare` (the cells and the pairs of scripts/delayed_oracle.pairs); the paper's cells from compare's paper fields.
@@ -20,7 +20,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pages import fmt, load_comparison, paper, provenance, table  # noqa: E402
 from pages.rest_util import commit_of, cpu_text, parser  # noqa: E402
 
-TASK, SPLIT = "pick_cube", "reference_seen"
+SPLIT = "reference_seen"
+TASK_ORDER = ["pick_cube", "push_cube", "pull_cube", "stack_cube"]
 BACKBONES = [("dp", "imitation (Diffusion Policy)"), ("mlp", "imitation (DAgger MLP)"), ("expert", "scripted"),
              ("ppo", "RL (PPO)")]
 DELAYED = [("delayed_oracle", "the intent unchanged for 6 steps, then the oracle"),
@@ -38,10 +39,16 @@ def includes_zero(cmp):
     return bool(cmp) and not cmp["difference"]["excludes_zero"]
 
 
-def verdict(C, bb):
-    """(status, reason) of "the adapters restore this backbone to its oracle", by the rule in the docstring."""
-    return rule(C.comparison("oracle", "exact_belief", TASK, SPLIT, bb),
-                [(label, C.comparison("oracle", label, TASK, SPLIT, bb), C.comparison(label, "exact_belief", TASK, SPLIT, bb))
+def tasks_of(C):
+    """The tasks the comparison holds, in the project's task order (others after, alphabetically)."""
+    have = C.values("task")
+    return [t for t in TASK_ORDER if t in have] + sorted(t for t in have if t not in TASK_ORDER)
+
+
+def verdict(C, task, bb):
+    """(status, reason) of "the adapters restore this backbone to its oracle" on a task, by the rule in the docstring."""
+    return rule(C.comparison("oracle", "exact_belief", task, SPLIT, bb),
+                [(label, C.comparison("oracle", label, task, SPLIT, bb), C.comparison(label, "exact_belief", task, SPLIT, bb))
                  for label, _ in DELAYED])
 
 
@@ -76,8 +83,8 @@ def rule(gap, delayed):
 
 
 def jobs_wall(C):
-    """`dp 43.2 min, mlp 10 s`: the jobs' own wall time per backbone, from their summaries' `wall_time_s` (each job's
-    last run: a page re-made over finished jobs still says what they cost)."""
+    """`dp` on pick_cube 43.2 min, `mlp` on pick_cube 10 s: the jobs' own wall time per task and backbone, from their
+    summaries' `wall_time_s` (each job's last run: a page re-made over finished jobs still says what they cost)."""
     sec = {}
     for c in C.cells:
         for j in c["jobs"]:
@@ -87,9 +94,11 @@ def jobs_wall(C):
                     with open(path) as f:
                         v = json.load(f).get("wall_time_s")
                     if v is not None:
-                        sec[c["backbone"]] = sec.get(c["backbone"], 0.0) + v
+                        key = (c["task"], c["backbone"])
+                        sec[key] = sec.get(key, 0.0) + v
                     break
-    return ", ".join(f"`{b}` {t / 60:.1f} min" if t >= 120 else f"`{b}` {t:.0f} s" for b, t in sec.items())
+    return ", ".join(f"`{b}` on {task} {t / 60:.1f} min" if t >= 120 else f"`{b}` on {task} {t:.0f} s"
+                     for (task, b), t in sec.items())
 
 
 def main():
@@ -97,13 +106,14 @@ def main():
     ap.add_argument("compare")
     a = ap.parse_args()
     C = load_comparison(a.compare)
+    tasks = tasks_of(C)
     specs = provenance.job_specs(C.input_dirs(), C.jobs())
     out = [provenance.header(
         "The cost of an episode's first steps: the oracle, delayed", "scripts/delayed_oracle_report.py", a.command or "?",
         commit_of(a), C.input_dirs(), provenance.spec_values(specs, "profile"), C.seeds(), C.episodes(), jobs=len(C.jobs()),
         episodes_per_seed=C.episodes_per_seed(), wall=a.wall, cores=a.cores, reused=a.reused,
         paper_source=C.paper_source(), bootstrap=C.bootstrap(),
-        extra=[f"Task `{TASK}`, split `{SPLIT}` (the paper's two seen contracts); `dp` at horizon 100 as the reference "
+        extra=[f"Task{'s' if len(tasks) > 1 else ''} {', '.join(f'`{t}`' for t in tasks)}, split `{SPLIT}` (the paper's two seen contracts of each); `dp` at horizon 100 as the reference "
                "evaluates it, the others at the task's 50" + cpu_text(a.cpu) + ".",
                f"The jobs' own wall time (their summaries' `wall_time_s`, whichever run of the command ran them): {jobs_wall(C) or fmt.DASH}."])]
     w = out.append
@@ -118,44 +128,49 @@ def main():
       "All methods of a backbone run the same episodes (paired initial states), so their differences are paired.\n\n")
     rows = []
     labels = dict(ORDER)
-    for bb, kind in BACKBONES:
-        for label, _ in ORDER:
-            c = C.cell(TASK, SPLIT, label, bb)
-            if c:
-                rows.append([f"`{bb}`", kind, f"`{label}`", labels[label], fmt.cell_rate(c), fmt.per_seed(c),
-                             fmt.probe_steps(c), fmt.safety(c), paper.cell_column(c),
-                             (paper.cell_entry(c) or {}).get("paper_backbone", fmt.DASH)])
+    for task in tasks:
+        for bb, kind in BACKBONES:
+            for label, _ in ORDER:
+                c = C.cell(task, SPLIT, label, bb)
+                if c:
+                    rows.append([task, f"`{bb}`", kind, f"`{label}`", labels[label], fmt.cell_rate(c), fmt.per_seed(c),
+                                 fmt.probe_steps(c), fmt.safety(c), paper.cell_column(c),
+                                 (paper.cell_entry(c) or {}).get("paper_backbone", fmt.DASH)])
     w("## Every cell\n\n")
-    w(table.markdown(["backbone", "paradigm", "method", "what ran", "success [Wilson 95 %]", "per seed", "probe steps",
+    w(table.markdown(["task", "backbone", "paradigm", "method", "what ran", "success [Wilson 95 %]", "per seed", "probe steps",
                       "flagged episodes", "paper", "paper's backbone"], rows))
-    po = paper.cell_entry(C.cell(TASK, SPLIT, "oracle", "dp") or {})
-    pe = paper.cell_entry(C.cell(TASK, SPLIT, "exact_belief", "dp") or {})
-    if po and pe:
-        w(f"\nIn the paper's own cells (the paper column) its Diffusion Policy's exact belief succeeds {fmt.num(pe['value'])} of\n"
-          f"the time and its oracle {fmt.num(po['value'])}: its adapter is not below its oracle, which is the claim. Ours: "
-          f"{fmt.cell_rate(C.cell(TASK, SPLIT, 'exact_belief', 'dp'))} against {fmt.cell_rate(C.cell(TASK, SPLIT, 'oracle', 'dp'))}.\n")
+    for task in tasks:
+        po = paper.cell_entry(C.cell(task, SPLIT, "oracle", "dp") or {})
+        pe = paper.cell_entry(C.cell(task, SPLIT, "exact_belief", "dp") or {})
+        if po and pe:
+            w(f"\nOn {task}, in the paper's own cells (the paper column), its Diffusion Policy's exact belief succeeds {fmt.num(pe['value'])}\n"
+              f"of the time and its oracle {fmt.num(po['value'])} (exact belief − oracle {pe['value'] - po['value']:+.3f}): the claim is that the adapter\n"
+              f"reaches its oracle. Ours: "
+              f"{fmt.cell_rate(C.cell(task, SPLIT, 'exact_belief', 'dp'))} against {fmt.cell_rate(C.cell(task, SPLIT, 'oracle', 'dp'))}.\n")
     w("\n## What the first steps cost, and what the adapter loses\n\n")
     w("Paired differences (bootstrap over seed, contract and episode) from compare, candidate − baseline.\n\n")
     rows = []
-    for bb, _ in BACKBONES:
-        for cand, base in [("oracle", lbl) for lbl, _ in DELAYED] + [("oracle", "exact_belief")] + [(lbl, "exact_belief") for lbl, _ in DELAYED]:
-            cmp = C.comparison(cand, base, TASK, SPLIT, bb)
-            if cmp:
-                rows.append([f"`{bb}`", f"`{cand}` − `{base}`", fmt.cmp_rates(cmp), fmt.cmp_diff(cmp, mark=True),
-                             fmt.per_seed_diff(cmp)])
-    w(table.markdown(["backbone", "difference", "rates", "difference [95 %]", "per seed"], rows))
+    for task in tasks:
+        for bb, _ in BACKBONES:
+            for cand, base in [("oracle", lbl) for lbl, _ in DELAYED] + [("oracle", "exact_belief")] + [(lbl, "exact_belief") for lbl, _ in DELAYED]:
+                cmp = C.comparison(cand, base, task, SPLIT, bb)
+                if cmp:
+                    rows.append([task, f"`{bb}`", f"`{cand}` − `{base}`", fmt.cmp_rates(cmp), fmt.cmp_diff(cmp, mark=True),
+                                 fmt.per_seed_diff(cmp)])
+    w(table.markdown(["task", "backbone", "difference", "rates", "difference [95 %]", "per seed"], rows))
     w("\n## The paper's claim\n\n")
     w("\"Restored by the same policy-agnostic adapters to its oracle ceiling\" (§5.8) is the paper's claim for its\n"
-      "Diffusion Policy: the `dp` row. The other rows test the same statement on the controls. Tested on the passive\n"
+      "Diffusion Policy: the `dp` rows. The other rows test the same statement on the controls. Tested on the passive\n"
       "adapter by the rule of scripts/delayed_oracle_report.py (written before the runs): reproduced when\n"
       "oracle − exact_belief includes 0; otherwise contradicted, with the reason the delayed oracles measure.\n\n")
     rows = []
-    for bb, _ in BACKBONES:
-        if not C.cells_where(backbone=bb):
-            continue
-        st, why = verdict(C, bb)
-        rows.append([f"`{bb}`", f"**{st}**", why])
-    w(table.markdown(["backbone", "status", "reason"], rows))
+    for task in tasks:
+        for bb, _ in BACKBONES:
+            if not C.cells_where(task=task, backbone=bb):
+                continue
+            st, why = verdict(C, task, bb)
+            rows.append([task, f"`{bb}`", f"**{st}**", why])
+    w(table.markdown(["task", "backbone", "status", "reason"], rows))
     notes = C.notes()
     if notes:
         w("\nNotes from `compare`: " + "; ".join(notes) + "\n")

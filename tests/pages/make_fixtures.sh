@@ -45,12 +45,14 @@ for page in $PAGES; do
         > "$D/$page/results/dp_cost.json"
     rm -rf "$bdir" ;;
   delayed_oracle)
-    # the expert and the DAgger MLP (the page's layout, not the Diffusion Policy's cost), every method of scripts/delayed_oracle
-    for b in expert mlp; do
+    # the expert and the DAgger MLP (the page's layout, not the Diffusion Policy's cost), every method of scripts/delayed_oracle,
+    # on pick_cube; the expert on push_cube too (the page's per-task layout)
+    for tb in pick_cube:expert pick_cube:mlp push_cube:expert; do
+      t=${tb%%:*} b=${tb#*:}
       for m in oracle 'delayed_oracle' 'delayed_oracle{delay=1}' 'delayed_oracle{before=hold}'; do
-        run --task pick_cube --split reference_seen --method "$m" --backbone "$b" --out "$D/$page/results"
+        run --task "$t" --split reference_seen --method "$m" --backbone "$b" --out "$D/$page/results"
       done
-      run --task pick_cube --split reference_seen --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
+      run --task "$t" --split reference_seen --method exact_belief --pool reference9 --backbone "$b" --out "$D/$page/results"
     done ;;
   backbone_variance)
     # three backbones of push_cube (the committed PPO and the two replicas), two seeds, every method of the pairs
