@@ -260,7 +260,10 @@ def main():
     if rows:
         w("How far the adapters restore the `dp` against its own oracle, and how much of any gap its first steps"
           " without the contract explain (an oracle that starts late, before any adapter could know the contract), is"
-          " measured on docs/results/delayed_oracle.md (`scripts/delayed_oracle`).\n")
+          " measured on docs/results/delayed_oracle.md (`scripts/delayed_oracle`, each task's seen contracts). Where a"
+          " `dp` restoration finding above is contradicted, that page"
+          " holds the measured reason: its verdict on \"restored to its oracle ceiling\" for the task, read off the"
+          " delayed oracles.\n")
     w("The paper's scalars (configs/paper/numbers.json by id):\n")
     rows = [[f"`{i}`", (numbers.by_id(i) or {}).get("quantity", fmt.DASH), scalar(numbers, i),
              (numbers.by_id(i) or {}).get("note", "")] for i in DP_IDS]
