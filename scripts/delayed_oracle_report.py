@@ -17,11 +17,10 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pages import fmt, load_comparison, paper, provenance, table  # noqa: E402
+from pages import fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
 from pages.rest_util import commit_of, cpu_text, parser  # noqa: E402
 
 SPLIT = "reference_seen"
-TASK_ORDER = ["pick_cube", "push_cube", "pull_cube", "stack_cube"]
 BACKBONES = [("dp", "imitation (Diffusion Policy)"), ("mlp", "imitation (DAgger MLP)"), ("expert", "scripted"),
              ("ppo", "RL (PPO)")]
 DELAYED = [("delayed_oracle", "the intent unchanged for 6 steps, then the oracle"),
@@ -37,12 +36,6 @@ def positive(cmp):
 
 def includes_zero(cmp):
     return bool(cmp) and not cmp["difference"]["excludes_zero"]
-
-
-def tasks_of(C):
-    """The tasks the comparison holds, in the project's task order (others after, alphabetically)."""
-    have = C.values("task")
-    return [t for t in TASK_ORDER if t in have] + sorted(t for t in have if t not in TASK_ORDER)
 
 
 def verdict(C, task, bb):
@@ -106,7 +99,7 @@ def main():
     ap.add_argument("compare")
     a = ap.parse_args()
     C = load_comparison(a.compare)
-    tasks = tasks_of(C)
+    tasks = sections.tasks(C)
     specs = provenance.job_specs(C.input_dirs(), C.jobs())
     out = [provenance.header(
         "The cost of an episode's first steps: the oracle, delayed", "scripts/delayed_oracle_report.py", a.command or "?",
