@@ -27,6 +27,10 @@ if(Python3_Interpreter_FOUND)
   add_test(NAME pages.delayed_oracle_verdict
            COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/delayed_oracle_verdict_test.py)
   set_tests_properties(pages.delayed_oracle_verdict PROPERTIES LABELS pages TIMEOUT 60)
+  # the brittleness page's rules for §5.8's Diffusion Policy claims (clean, collapse, restoration to the oracle, probe steps)
+  add_test(NAME pages.brittleness_dp_claims
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/brittleness_dp_claims_test.py)
+  set_tests_properties(pages.brittleness_dp_claims PROPERTIES LABELS pages TIMEOUT 60)
   # the brittleness page's sentence on its own Diffusion Policy jobs: one thread's CPU time against wall time, like with like
   add_test(NAME pages.brittleness_cost_text
            COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/brittleness_cost_text_test.py)
