@@ -6,10 +6,12 @@ the status the rule gives and a phrase of its reason.
 usage: tests/pages/delayed_oracle_verdict_test.py"""
 import os
 import sys
+from functools import partial
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from delayed_oracle_report import rule  # noqa: E402
+from rule_cases import run_cases  # noqa: E402
 
 
 def cmp(est, lo, hi):
@@ -36,16 +38,6 @@ CASES = [
 ]
 
 
-def main():
-    bad = 0
-    for gap, delayed, want, phrase in CASES:
-        st, why = rule(gap, delayed)
-        if st != want or phrase not in why:
-            print(f"FAIL: want {want} with {phrase!r}, got {st}: {why}")
-            bad += 1
-    print(f"{len(CASES) - bad}/{len(CASES)} cases")
-    return 1 if bad else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_cases("delayed-oracle rule", [(want, phrase, partial(rule, gap, delayed))
+                                              for gap, delayed, want, phrase in CASES]))

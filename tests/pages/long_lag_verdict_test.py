@@ -6,10 +6,12 @@ small to reach the `reproduced` branch). Each case names the status the rule giv
 usage: tests/pages/long_lag_verdict_test.py"""
 import os
 import sys
+from functools import partial
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from long_lag_report import probe_claim_status  # noqa: E402
+from rule_cases import run_cases  # noqa: E402
 
 
 def cmp(est, lo, hi, pairs=600):
@@ -33,17 +35,7 @@ CASES = [
 ]
 
 
-def main():
-    bad = 0
-    for dr, dd, printed, want, phrase in CASES:
-        st, why = probe_claim_status(dr, dd, "ppo", "ppo-delay-aware", printed)
-        if st != want or phrase not in why:
-            print(f"FAILED: d_r {dr and dr['difference']}, d_d {dd and dd['difference']}, printed {printed}: "
-                  f"got {st!r} ({why}), want {want!r} with {phrase!r}")
-            bad += 1
-    print(f"long_lag verdict rule: {len(CASES) - bad}/{len(CASES)} cases as the page states")
-    return 1 if bad else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_cases("long_lag verdict rule",
+                       [(want, phrase, partial(probe_claim_status, dr, dd, "ppo", "ppo-delay-aware", printed))
+                        for dr, dd, printed, want, phrase in CASES]))
