@@ -324,6 +324,10 @@ def main():
               if c.get("paper") and c["candidate"] != "oracle"]
     w(findings.findings_table(items) if items else "No pair with a paper difference was run.\n")
     w("")
+    if any(c["backbone"] == "dp" for _, c in items):
+        w("For `dp` a row above tests only that an adapter lifts the backbone above no adaptation, with the paper's"
+          " sign. §5.8 claims restoration *to the oracle ceiling*, which the claims table of the next section tests"
+          " on the oracle − adapter pairs: a `dp` row marked reproduced here can be contradicted there.\n")
     w("## The Diffusion Policy (§5.8)\n")
     w("The paper's imitation backbone is a Diffusion Policy; ours are the DAgger MLP (`mlp`) and, where a weight file"
       " is adopted (docs/backbones.md), a Diffusion Policy trained here from the scripted expert's demonstrations"
