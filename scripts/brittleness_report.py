@@ -93,11 +93,11 @@ def dp_probe_status(cell):
     0.05 steps per episode), contradicted otherwise, untestable when the cell was not run. Rule written before any
     Diffusion Policy ran."""
     if not cell:
-        return "untestable", "the cell was not run here"
+        return findings.UNTESTABLE, "the cell was not run here"
     m = cell["mean_probe_steps"]
     if m < 0.05:
-        return "reproduced", f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes"
-    return "contradicted", f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes, against the paper's 0.0"
+        return findings.REPRODUCED, f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes"
+    return findings.CONTRADICTED, f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes, against the paper's 0.0"
 
 
 def dp_clean_status(paper_rate, seeds):
@@ -107,7 +107,7 @@ def dp_clean_status(paper_rate, seeds):
     Rule written after the pick_cube `dp` clean rates were first published here; it is the plain reading of a
     per-seed interval, with no threshold to choose."""
     if paper_rate is None or not seeds:
-        return "untestable", "no clean run here" if not seeds else "the paper gives no clean rate for this task"
+        return findings.UNTESTABLE, "no clean run here" if not seeds else "the paper gives no clean rate for this task"
     ivs = [v["competence"]["interval"] for _, v in seeds]
     inside = sum(w["lower"] <= paper_rate <= w["upper"] for w in ivs)
     above = sum(w["lower"] > paper_rate for w in ivs)
@@ -115,7 +115,7 @@ def dp_clean_status(paper_rate, seeds):
     why = f"the paper's {paper_rate:.3f} is inside {inside} of {len(ivs)} seeds' Wilson intervals"
     if above or below:
         why += f" (ours above it on {above}, below it on {below})"
-    return ("reproduced" if 2 * inside > len(ivs) else "contradicted"), why
+    return (findings.REPRODUCED if 2 * inside > len(ivs) else findings.CONTRADICTED), why
 
 
 def dp_collapse_status(cell, floor_max):
@@ -123,11 +123,11 @@ def dp_collapse_status(cell, floor_max):
     our Wilson interval reaches the floor (its lower bound at most the floor's top, 0.007), contradicted when the
     whole interval lies above it."""
     if not cell:
-        return "untestable", "the cell was not run here"
+        return findings.UNTESTABLE, "the cell was not run here"
     w = cell["success_once"]
     if w["lower"] <= floor_max:
-        return "reproduced", f"our interval {fmt.interval(w['lower'], w['upper'])} reaches the paper's floor (at most {floor_max:.3f})"
-    return "contradicted", f"our interval {fmt.interval(w['lower'], w['upper'])} lies above the paper's floor (at most {floor_max:.3f})"
+        return findings.REPRODUCED, f"our interval {fmt.interval(w['lower'], w['upper'])} reaches the paper's floor (at most {floor_max:.3f})"
+    return findings.CONTRADICTED, f"our interval {fmt.interval(w['lower'], w['upper'])} lies above the paper's floor (at most {floor_max:.3f})"
 
 
 def dp_restore_status(cmp, adapter, ceiling):
@@ -137,16 +137,16 @@ def dp_restore_status(cmp, adapter, ceiling):
     when it excludes 0 with the adapter below; untestable when either label was not run, or when the oracle itself
     does not lift the backbone above no adaptation (ceiling: oracle − no_adapt; no ceiling to restore to)."""
     if not cmp:
-        return "untestable", f"oracle or {adapter} was not run here"
+        return findings.UNTESTABLE, f"oracle or {adapter} was not run here"
     if not ceiling or not (ceiling["difference"]["excludes_zero"] and ceiling["difference"]["estimate"] > 0):
-        return "untestable", ("the oracle does not lift it above no adaptation (oracle − no_adapt "
+        return findings.UNTESTABLE, ("the oracle does not lift it above no adaptation (oracle − no_adapt "
                               f"{fmt.diff(ceiling['difference']) if ceiling else fmt.DASH}): no ceiling to restore to")
     d = cmp["difference"]
     if not d["excludes_zero"]:
-        return "reproduced", f"oracle − {adapter} {fmt.diff(d)} includes 0"
+        return findings.REPRODUCED, f"oracle − {adapter} {fmt.diff(d)} includes 0"
     if d["estimate"] < 0:
-        return "reproduced", f"{adapter} is above its oracle: oracle − {adapter} {fmt.diff(d)}"
-    return "contradicted", (f"{adapter} is below its oracle: oracle − {adapter} {fmt.diff(d)} excludes 0; how much of it the"
+        return findings.REPRODUCED, f"{adapter} is above its oracle: oracle − {adapter} {fmt.diff(d)}"
+    return findings.CONTRADICTED, (f"{adapter} is below its oracle: oracle − {adapter} {fmt.diff(d)} excludes 0; how much of it the"
                             " first steps without the contract explain is measured on docs/results/delayed_oracle.md")
 
 

@@ -17,7 +17,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pages import fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
+from pages import findings, fmt, load_comparison, paper, provenance, sections, table  # noqa: E402
 from pages.rest_util import commit_of, cpu_text, parser  # noqa: E402
 
 SPLIT = "reference_seen"
@@ -49,11 +49,11 @@ def rule(gap, delayed):
     """The rule on compare's comparisons: gap = oracle − exact_belief; delayed = [(label, oracle − label,
     label − exact_belief)] (None where not run)."""
     if not gap:
-        return "untestable", "oracle or exact_belief was not run"
+        return findings.UNTESTABLE, "oracle or exact_belief was not run"
     if not gap["difference"]["excludes_zero"]:
-        return "reproduced", f"oracle − exact_belief {fmt.diff(gap['difference'])} includes 0"
+        return findings.REPRODUCED, f"oracle − exact_belief {fmt.diff(gap['difference'])} includes 0"
     if gap["difference"]["estimate"] < 0:
-        return "contradicted", f"exact_belief is above its oracle: oracle − exact_belief {fmt.diff(gap['difference'])}"
+        return findings.CONTRADICTED, f"exact_belief is above its oracle: oracle − exact_belief {fmt.diff(gap['difference'])}"
     whole, part = [], []
     for label, cost, rest in delayed:
         if not positive(cost):
@@ -66,13 +66,13 @@ def rule(gap, delayed):
             part.append(text + (", which excludes 0" if rest else ""))
     head = f"exact_belief is below its oracle (oracle − exact_belief {fmt.diff(gap['difference'])}); "
     if whole:
-        return "contradicted", (head + "measured reason: the first steps without the contract, which the backbone does not recover "
+        return findings.CONTRADICTED, (head + "measured reason: the first steps without the contract, which the backbone does not recover "
                                 "from; a delay whose difference from exact_belief includes 0 accounts for the adapter's loss: "
                                 + "; ".join(whole + part))
     if part:
-        return "contradicted", (head + "measured reason, in part: the first steps without the contract; each delay below costs the "
+        return findings.CONTRADICTED, (head + "measured reason, in part: the first steps without the contract; each delay below costs the "
                                 "oracle but stays above exact_belief, so it accounts for part of the loss: " + "; ".join(part))
-    return "contradicted", head + "no delay tried costs the oracle a difference that excludes 0, so the first steps are not the reason; the cause is not found here"
+    return findings.CONTRADICTED, head + "no delay tried costs the oracle a difference that excludes 0, so the first steps are not the reason; the cause is not found here"
 
 
 def jobs_wall(C):

@@ -16,7 +16,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pages import fmt, load_comparison, paper, provenance, table  # noqa: E402
+from pages import findings, fmt, load_comparison, paper, provenance, table  # noqa: E402
 from pages.rest_util import ROOT, commit_of, cpu_text, parser, rel, scalar  # noqa: E402
 
 PAIRS = [("expert", "expert-delay-aware"), ("mlp", "mlp-delay-aware"), ("ppo", "ppo-delay-aware")]
@@ -75,10 +75,10 @@ def delay_status(cmp):
     d = cmp["difference"]
     ours = fmt.cmp_diff(cmp)
     if d["lower"] > 0:
-        return "reproduced", f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, delay-aware above"
+        return findings.REPRODUCED, f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, delay-aware above"
     if d["upper"] < 0:
-        return "contradicted", f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, reactive above"
-    return "inconclusive", f"our paired difference {ours} over {cmp['pairs']} episodes includes 0"
+        return findings.CONTRADICTED, f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, reactive above"
+    return findings.INCONCLUSIVE, f"our paired difference {ours} over {cmp['pairs']} episodes includes 0"
 
 
 def lag4_status(entries, lo, hi):
@@ -87,7 +87,7 @@ def lag4_status(entries, lo, hi):
     four = [e for lag, e in entries if lag == 4]
     rest = [e for lag, e in entries if lag != 4]
     if not four or not rest:
-        return "untestable", "the cell has no lag-4 contract, or no other contract to set it against"
+        return findings.UNTESTABLE, "the cell has no lag-4 contract, or no other contract to set it against"
     w4 = [e["success_once"] for e in four]
     wr = [e["success_once"] for e in rest]
     in_range = all(w["lower"] <= hi and w["upper"] >= lo for w in w4)
@@ -95,12 +95,12 @@ def lag4_status(entries, lo, hi):
     above = any(w["lower"] > o["upper"] for w in w4 for o in wr)
     rng = f"[{fmt.num(lo, 2)}, {fmt.num(hi, 2)}]"
     if not in_range:
-        return "contradicted", f"the lag-4 Wilson interval misses the paper's range {rng}"
+        return findings.CONTRADICTED, f"the lag-4 Wilson interval misses the paper's range {rng}"
     if above:
-        return "contradicted", "the lag-4 contract is above another contract (disjoint Wilson intervals)"
+        return findings.CONTRADICTED, "the lag-4 contract is above another contract (disjoint Wilson intervals)"
     if lowest:
-        return "reproduced", f"the lag-4 Wilson interval meets {rng} and lies below every other contract's"
-    return "inconclusive", f"the lag-4 Wilson interval meets {rng} but overlaps another contract's (not shown to be the hardest)"
+        return findings.REPRODUCED, f"the lag-4 Wilson interval meets {rng} and lies below every other contract's"
+    return findings.INCONCLUSIVE, f"the lag-4 Wilson interval meets {rng} but overlaps another contract's (not shown to be the hardest)"
 
 
 def within(C, task, split, candidate, backbone):
@@ -130,14 +130,14 @@ def probe_claim_status(dr, dd, rb, db, printed=None):
         > 0: an interval [0, 0], no episode differing, shows nothing);
       inconclusive: anything else (the reason names the part not shown)."""
     if not dr or not dd:
-        return "untestable", "compare holds no entropy − fixed comparison on " + ("`" + rb + "`" if not dr else "`" + db + "`")
+        return findings.UNTESTABLE, "compare holds no entropy − fixed comparison on " + ("`" + rb + "`" if not dr else "`" + db + "`")
     a, b = dr["difference"], dd["difference"]
     txt_r = f"on `{rb}` entropy − fixed {fmt.cmp_diff(dr)} over {dr['pairs']} episodes"
     txt_d = f"on `{db}` entropy − fixed {fmt.cmp_diff(dd)} over {dd['pairs']} episodes"
     if a["lower"] > 0:
-        return "contradicted", f"{txt_r} excludes 0 with entropy above: the reactive premise (fixed above entropy) fails"
+        return findings.CONTRADICTED, f"{txt_r} excludes 0 with entropy above: the reactive premise (fixed above entropy) fails"
     if b["upper"] < 0:
-        return "contradicted", f"{txt_d} excludes 0 with fixed still above: no turn-over on the delay-aware backbone"
+        return findings.CONTRADICTED, f"{txt_d} excludes 0 with fixed still above: no turn-over on the delay-aware backbone"
     if a["upper"] < 0:
         premise = f"{txt_r} excludes 0 (fixed above)"
     elif printed is not None and round(printed, 3) > 0 and round(-a["estimate"], 3) >= round(printed, 3):
@@ -148,7 +148,7 @@ def probe_claim_status(dr, dd, rb, db, printed=None):
     shown = b["lower"] >= 0 and b["upper"] > 0
     if premise and shown:
         strict = "excludes 0, entropy above" if b["lower"] > 0 else "lower bound 0: entropy at least fixed"
-        return "reproduced", f"{premise}; {txt_d} ({strict})"
+        return findings.REPRODUCED, f"{premise}; {txt_d} ({strict})"
     missing = [] if not premise else [f"the reactive premise holds ({premise})"]
     if not premise:
         missing.append(f"the reactive premise is not shown ({txt_r}"
@@ -156,7 +156,7 @@ def probe_claim_status(dr, dd, rb, db, printed=None):
     if not shown:
         missing.append(f"entropy ≥ fixed is not shown on the delay-aware backbone ({txt_d}"
                        + (", no episode differs)" if b["upper"] <= 0 and b["lower"] >= 0 else ", includes 0)"))
-    return "inconclusive", "; ".join(missing)
+    return findings.INCONCLUSIVE, "; ".join(missing)
 
 
 def paper_probe_cell(cell, backbone, split):
@@ -374,7 +374,7 @@ def main():
             if lo_e and hi_e:
                 st, why = lag4_status(by_lag(cell, lags["reference_long_lag"]), lo_e["value"], hi_e["value"])
             else:
-                st, why = "untestable", "configs/paper/numbers.json has no §5.7 lag-4 range"
+                st, why = findings.UNTESTABLE, "configs/paper/numbers.json has no §5.7 lag-4 range"
             rows.append([f"{finding}: {task}, `{db}`", f"**{st}**", why])
     if not n_lag:
         rows.append([finding, "**untestable**", "no delay-aware oracle-encode cell on reference_long_lag"])

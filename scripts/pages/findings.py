@@ -13,6 +13,7 @@ difference."""
 from . import fmt, paper, table
 
 REPRODUCED, CONTRADICTED, UNTESTABLE = "reproduced", "contradicted", "untestable"
+INCONCLUSIVE = "inconclusive"  # a page rule's status when its data neither reproduce nor contradict the claim
 
 
 def status(cmp, missing="the cell was not run here"):
