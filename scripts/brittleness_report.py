@@ -97,7 +97,8 @@ def dp_probe_status(cell):
     m = cell["mean_probe_steps"]
     if m < 0.05:
         return findings.REPRODUCED, f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes"
-    return findings.CONTRADICTED, f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes, against the paper's 0.0"
+    return findings.CONTRADICTED, (f"ours {m:.2f} probe steps per episode over {cell['episodes']} episodes,"
+                                   " against the paper's 0.0")
 
 
 def dp_clean_status(paper_rate, seeds):
@@ -125,9 +126,10 @@ def dp_collapse_status(cell, floor_max):
     if not cell:
         return findings.UNTESTABLE, "the cell was not run here"
     w = cell["success_once"]
+    ours = f"our interval {fmt.interval(w['lower'], w['upper'])}"
     if w["lower"] <= floor_max:
-        return findings.REPRODUCED, f"our interval {fmt.interval(w['lower'], w['upper'])} reaches the paper's floor (at most {floor_max:.3f})"
-    return findings.CONTRADICTED, f"our interval {fmt.interval(w['lower'], w['upper'])} lies above the paper's floor (at most {floor_max:.3f})"
+        return findings.REPRODUCED, f"{ours} reaches the paper's floor (at most {floor_max:.3f})"
+    return findings.CONTRADICTED, f"{ours} lies above the paper's floor (at most {floor_max:.3f})"
 
 
 def dp_restore_status(cmp, adapter, ceiling):
@@ -140,14 +142,15 @@ def dp_restore_status(cmp, adapter, ceiling):
         return findings.UNTESTABLE, f"oracle or {adapter} was not run here"
     if not ceiling or not (ceiling["difference"]["excludes_zero"] and ceiling["difference"]["estimate"] > 0):
         return findings.UNTESTABLE, ("the oracle does not lift it above no adaptation (oracle − no_adapt "
-                              f"{fmt.diff(ceiling['difference']) if ceiling else fmt.DASH}): no ceiling to restore to")
+                                     f"{fmt.diff(ceiling['difference']) if ceiling else fmt.DASH}): no ceiling to restore to")
     d = cmp["difference"]
     if not d["excludes_zero"]:
         return findings.REPRODUCED, f"oracle − {adapter} {fmt.diff(d)} includes 0"
     if d["estimate"] < 0:
         return findings.REPRODUCED, f"{adapter} is above its oracle: oracle − {adapter} {fmt.diff(d)}"
-    return findings.CONTRADICTED, (f"{adapter} is below its oracle: oracle − {adapter} {fmt.diff(d)} excludes 0; how much of it the"
-                            " first steps without the contract explain is measured on docs/results/delayed_oracle.md")
+    return findings.CONTRADICTED, (f"{adapter} is below its oracle: oracle − {adapter} {fmt.diff(d)} excludes 0; how much"
+                                   " of it the first steps without the contract explain is measured on"
+                                   " docs/results/delayed_oracle.md")
 
 
 def dp_claims(C, clean, numbers, task):

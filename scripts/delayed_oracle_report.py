@@ -53,7 +53,8 @@ def rule(gap, delayed):
     if not gap["difference"]["excludes_zero"]:
         return findings.REPRODUCED, f"oracle − exact_belief {fmt.diff(gap['difference'])} includes 0"
     if gap["difference"]["estimate"] < 0:
-        return findings.CONTRADICTED, f"exact_belief is above its oracle: oracle − exact_belief {fmt.diff(gap['difference'])}"
+        return findings.CONTRADICTED, ("exact_belief is above its oracle: oracle − exact_belief "
+                                       f"{fmt.diff(gap['difference'])}")
     whole, part = [], []
     for label, cost, rest in delayed:
         if not positive(cost):
@@ -66,13 +67,15 @@ def rule(gap, delayed):
             part.append(text + (", which excludes 0" if rest else ""))
     head = f"exact_belief is below its oracle (oracle − exact_belief {fmt.diff(gap['difference'])}); "
     if whole:
-        return findings.CONTRADICTED, (head + "measured reason: the first steps without the contract, which the backbone does not recover "
-                                "from; a delay whose difference from exact_belief includes 0 accounts for the adapter's loss: "
-                                + "; ".join(whole + part))
+        return findings.CONTRADICTED, (head + "measured reason: the first steps without the contract, which the backbone"
+                                       " does not recover from; a delay whose difference from exact_belief includes 0"
+                                       " accounts for the adapter's loss: " + "; ".join(whole + part))
     if part:
-        return findings.CONTRADICTED, (head + "measured reason, in part: the first steps without the contract; each delay below costs the "
-                                "oracle but stays above exact_belief, so it accounts for part of the loss: " + "; ".join(part))
-    return findings.CONTRADICTED, head + "no delay tried costs the oracle a difference that excludes 0, so the first steps are not the reason; the cause is not found here"
+        return findings.CONTRADICTED, (head + "measured reason, in part: the first steps without the contract; each delay"
+                                       " below costs the oracle but stays above exact_belief, so it accounts for part of"
+                                       " the loss: " + "; ".join(part))
+    return findings.CONTRADICTED, (head + "no delay tried costs the oracle a difference that excludes 0, so the first steps"
+                                   " are not the reason; the cause is not found here")
 
 
 def jobs_wall(C):

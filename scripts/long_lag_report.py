@@ -73,12 +73,12 @@ def delay_status(cmp):
     """The paper's Table 4 claim (delay-aware above reactive) against our paired difference: the paper prints
     ratios with no interval for the difference, so the claim is read as its sign."""
     d = cmp["difference"]
-    ours = fmt.cmp_diff(cmp)
+    ours = f"our paired difference {fmt.cmp_diff(cmp)} over {cmp['pairs']} episodes"
     if d["lower"] > 0:
-        return findings.REPRODUCED, f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, delay-aware above"
+        return findings.REPRODUCED, f"{ours} excludes 0, delay-aware above"
     if d["upper"] < 0:
-        return findings.CONTRADICTED, f"our paired difference {ours} over {cmp['pairs']} episodes excludes 0, reactive above"
-    return findings.INCONCLUSIVE, f"our paired difference {ours} over {cmp['pairs']} episodes includes 0"
+        return findings.CONTRADICTED, f"{ours} excludes 0, reactive above"
+    return findings.INCONCLUSIVE, f"{ours} includes 0"
 
 
 def lag4_status(entries, lo, hi):
@@ -100,7 +100,8 @@ def lag4_status(entries, lo, hi):
         return findings.CONTRADICTED, "the lag-4 contract is above another contract (disjoint Wilson intervals)"
     if lowest:
         return findings.REPRODUCED, f"the lag-4 Wilson interval meets {rng} and lies below every other contract's"
-    return findings.INCONCLUSIVE, f"the lag-4 Wilson interval meets {rng} but overlaps another contract's (not shown to be the hardest)"
+    return findings.INCONCLUSIVE, (f"the lag-4 Wilson interval meets {rng} but overlaps another contract's"
+                                   " (not shown to be the hardest)")
 
 
 def within(C, task, split, candidate, backbone):
@@ -130,12 +131,13 @@ def probe_claim_status(dr, dd, rb, db, printed=None):
         > 0: an interval [0, 0], no episode differing, shows nothing);
       inconclusive: anything else (the reason names the part not shown)."""
     if not dr or not dd:
-        return findings.UNTESTABLE, "compare holds no entropy − fixed comparison on " + ("`" + rb + "`" if not dr else "`" + db + "`")
+        return findings.UNTESTABLE, f"compare holds no entropy − fixed comparison on `{rb if not dr else db}`"
     a, b = dr["difference"], dd["difference"]
     txt_r = f"on `{rb}` entropy − fixed {fmt.cmp_diff(dr)} over {dr['pairs']} episodes"
     txt_d = f"on `{db}` entropy − fixed {fmt.cmp_diff(dd)} over {dd['pairs']} episodes"
     if a["lower"] > 0:
-        return findings.CONTRADICTED, f"{txt_r} excludes 0 with entropy above: the reactive premise (fixed above entropy) fails"
+        return findings.CONTRADICTED, (f"{txt_r} excludes 0 with entropy above: the reactive premise (fixed above"
+                                       " entropy) fails")
     if b["upper"] < 0:
         return findings.CONTRADICTED, f"{txt_d} excludes 0 with fixed still above: no turn-over on the delay-aware backbone"
     if a["upper"] < 0:
@@ -360,7 +362,7 @@ def main():
                     rows.append([f"delay-aware beats reactive on the long lag (Table 4): {task}, {METHOD_NAME[method]}, "
                                  f"`{db}` − `{rb}`", f"**{st}**", why])
     if not rows:
-        rows.append(["delay-aware beats reactive on the long lag (Table 4)", "**untestable**",
+        rows.append(["delay-aware beats reactive on the long lag (Table 4)", findings.bold(findings.UNTESTABLE),
                      "no cross-backbone comparison on reference_long_lag in the compare JSON"])
     finding = (f"lag 4 stays hardest, {scalar(numbers, 's5.7.lag4.oracle.success_once_lag4_min', 2)}–"
                f"{scalar(numbers, 's5.7.lag4.oracle.success_once_lag4_max', 2)} with oracle-encode")
@@ -377,7 +379,7 @@ def main():
                 st, why = findings.UNTESTABLE, "configs/paper/numbers.json has no §5.7 lag-4 range"
             rows.append([f"{finding}: {task}, `{db}`", f"**{st}**", why])
     if not n_lag:
-        rows.append([finding, "**untestable**", "no delay-aware oracle-encode cell on reference_long_lag"])
+        rows.append([finding, findings.bold(findings.UNTESTABLE), "no delay-aware oracle-encode cell on reference_long_lag"])
     for task, st, why in claim_rows:
         rows.append([f"{CLAIM}: {task} (the rule: section *Fixed vs entropy probing under lag*)", f"**{st}**", why])
     w(table.markdown(["finding", "status", "reason"], rows))
