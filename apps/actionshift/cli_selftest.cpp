@@ -70,12 +70,19 @@ void register_selftest_commands(CLI::App& app, CliContext& ctx) {
   audit->add_option("--task", audit_o.task, "Use this task's built-in calibration (pick_cube, ...)")->excludes(audit_cal);
   audit->add_option("--profile", audit_o.profile, "With --task: the simulator profile of the calibration")->check(kProfile)
       ->capture_default_str();
-  audit->add_option("--confidence-floor", audit_o.audit.confidence_floor, "Posterior mass a field needs to be resolved")->capture_default_str();
-  audit->add_option("--misspec-ratio", audit_o.audit.misspec_ratio, "Abstain when the best contract fits worse than this x the calibrated noise variance")
+  audit->add_option("--confidence-floor", audit_o.audit.confidence_floor,
+                    "Confidence a field needs to be committed: the one-sided level of the tests over the log's episodes\n"
+                    "(a hypothesis excluded, a coefficient standing out of its jackknife uncertainty)")->capture_default_str();
+  audit->add_option("--min-explained", audit_o.audit.min_explained,
+                    "Share of an output channel's motion variance its read raw channel must explain to be committed")
+      ->capture_default_str();
+  audit->add_option("--outlier-z", audit_o.audit.outlier_z,
+                    "Rows whose residual exceeds this many robust standard deviations are left out")->capture_default_str();
+  audit->add_option("--misspec-ratio", audit_o.audit.misspec_ratio, "With a calibration: abstain when the best hypothesis fits worse than this x the calibrated noise variance")
       ->capture_default_str();
   audit->add_option("--gain-tolerance", audit_o.audit.gain_tolerance,
-                    "Factor by which a log's response gain may differ from the calibrated one (scale is the set of grid\n"
-                    "values within it)")->capture_default_str();
+                    "Factor by which a log's response gain may differ from the calibrated one: a channel's scale is\n"
+                    "claimed only as the band of the log's gain within this factor (and two standard errors)")->capture_default_str();
   audit->add_option("--max-steps", audit_o.max_steps, "Audit only the first N transitions");
   audit->add_flag("--json", audit_o.json, "Print one JSON object instead of the text report");
   audit->callback([&] { ctx.action = [&] { return cli::run_audit(audit_o); }; });

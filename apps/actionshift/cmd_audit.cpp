@@ -96,6 +96,8 @@ int audit(const AuditCliOptions& o) {
     j["confidence_floor"] = ao.confidence_floor;
     j["misspec_ratio"] = ao.misspec_ratio;
     j["gain_tolerance"] = ao.gain_tolerance;
+    j["min_explained"] = ao.min_explained;
+    j["outlier_z"] = ao.outlier_z;
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << selftest::to_text(r) << "Declared: " << declared_from << "; response model: " << model_from << "; layout: " << log.layout

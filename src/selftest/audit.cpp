@@ -1,7 +1,8 @@
 // Audit a log (docs/audit.md): the identification core and its reports.
 #include "actionshift/selftest/audit.hpp"
 
-#include "actionshift/adapt/grammar_belief.hpp"
+#include "audit_detail.hpp"
+
 #include "actionshift/core/canonical_json.hpp"
 #include "actionshift/core/error.hpp"
 #include "actionshift/core/grammar.hpp"
@@ -207,6 +208,10 @@ std::string validate(const AuditOptions& o) {
     return "audit options: misspec_ratio must be finite and > 0 (got " + fmt("%g", o.misspec_ratio) + ")";
   if (!(o.min_excitation >= 0.0) || !std::isfinite(o.min_excitation))
     return "audit options: min_excitation must be finite and >= 0 (got " + fmt("%g", o.min_excitation) + ")";
+  if (!(o.min_explained >= 0.0 && o.min_explained < 1.0))
+    return "audit options: min_explained must be in [0, 1) (got " + fmt("%g", o.min_explained) + ")";
+  if (!(o.outlier_z > 0.0))
+    return "audit options: outlier_z must be > 0 (got " + fmt("%g", o.outlier_z) + ")";
   if (!(o.gain_tolerance >= 1.0) || !std::isfinite(o.gain_tolerance))
     return "audit options: gain_tolerance must be finite and >= 1 (got " + fmt("%g", o.gain_tolerance) + ")";
   if (!(o.min_rotation_spread >= 0.0) || !std::isfinite(o.min_rotation_spread))
@@ -235,312 +240,13 @@ const AuditField* AuditResult::field(std::string_view name) const {
   return nullptr;
 }
 
-// ---- identification
+// ---- identification (the evidence model: audit_evidence.cpp)
 
 namespace {
 
-constexpr int kModes = adapt::GrammarBelief::kModes;
-constexpr int kSK = adapt::GrammarBelief::kSigns * adapt::GrammarBelief::kScales;
-constexpr int kFrames = 2;
-constexpr int kPerms = 720;
-
-using Cells = std::vector<double>;  // [f][m][i][j][sk]
-inline std::size_t cidx(int f, int m, int i, int j, int sk) {
-  return static_cast<std::size_t>(((((f * kModes + m) * kPoseDim + i) * kPoseDim + j) * kSK) + sk);
-}
-
-struct Step {
-  Action raw;
-  Pose6 response;                      // measured, physical units
-  Pose6 cumulative;                    // Σ of the episode's responses through this step
-  Mat3 R;                              // TCP orientation before the step
-  Vec3 pos, next_pos;
-  std::optional<double> finger_next;   // mean finger position after the step
-  bool first{false};                   // first step of an episode
-  int unit{0};                         // the jackknife's unit: the episode, or a quarter of a log of < 4 episodes
-};
-
-// No single episode decides a field: the units left out one at a time are the episodes, or in a log of
-// fewer than four episodes, each episode cut into equal contiguous parts (four parts or more in all).
-constexpr std::size_t kMinUnits = 4;
-
-std::vector<std::vector<Step>> transitions_of(const ActionLog& log) {
-  std::vector<std::vector<Step>> out;
-  for (const auto& ep : log.episodes) {
-    std::vector<Step> steps;
-    const std::size_t n = std::min(ep.actions.size(), ep.poses.empty() ? 0 : ep.poses.size() - 1);
-    for (std::size_t t = 0; t < n; ++t) {
-      const TcpPose& a = ep.poses[t];
-      const TcpPose& b = ep.poses[t + 1];
-      Step s;
-      s.raw = ep.actions[t];
-      const Eigen::Vector4d qa = a.quaternion / a.quaternion.norm();
-      const Eigen::Vector4d qb = b.quaternion / b.quaternion.norm();
-      s.response.head<3>() = b.position - a.position;
-      const Eigen::Vector4d qa_conj(qa[0], -qa[1], -qa[2], -qa[3]);
-      s.response.tail<3>() = adapt::quat_to_rotvec(adapt::quat_multiply(qb, qa_conj));
-      s.R = Eigen::Quaterniond(qa[0], qa[1], qa[2], qa[3]).toRotationMatrix();
-      s.pos = a.position;
-      s.next_pos = b.position;
-      if (b.fingers) s.finger_next = 0.5 * ((*b.fingers)[0] + (*b.fingers)[1]);
-      s.first = t == 0;
-      s.cumulative = (steps.empty() ? Pose6::Zero() : steps.back().cumulative) + s.response;
-      steps.push_back(s);
-    }
-    if (!steps.empty()) out.push_back(std::move(steps));
-  }
-  const std::size_t parts = out.size() >= kMinUnits ? 1 : (kMinUnits + out.size() - 1) / std::max<std::size_t>(out.size(), 1);
-  int unit = 0;
-  for (auto& ep : out) {
-    for (std::size_t t = 0; t < ep.size(); ++t) ep[t].unit = unit + static_cast<int>(t * parts / ep.size());
-    unit += static_cast<int>(std::min(parts, ep.size()));
-  }
-  return out;
-}
-
-int units_of(const std::vector<std::vector<Step>>& eps) { return eps.empty() ? 0 : eps.back().back().unit + 1; }
-
-// the drive of (target, lag) on raw channel j at step t of an episode (zeros before its start)
-double drive(const std::vector<Step>& ep, std::size_t t, Target target, int lag, int j) {
-  const auto at = [&](std::size_t d) { return t >= d ? ep[t - d].raw[j] : 0.0; };
-  const double x = at(static_cast<std::size_t>(lag));
-  return target == Target::kDelta ? x : x - at(static_cast<std::size_t>(lag) + 1);
-}
-
-// The response of step t in the coordinates a hypothesis (frame f, target, lag) decodes in, each
-// channel divided by `alpha` first. Base frame (f = 0): as measured. Tool frame (f = 1), exactly as
-// the controller decodes: the command that moved the robot at step t was decoded `lag` steps earlier,
-// under that step's rotation R_{t−L}, so a delta is R_{t−L}ᵀ·response_t; an absolute target is the
-// difference of two targets decoded under two rotations, and since the tracked target starts at zero
-// with the episode, the cumulative response s_t is the target: R_{t−L}ᵀ·s_t − R_{t−L−1}ᵀ·s_{t−1}.
-// (Reading both under the current rotation, as a first version did, is wrong by the turn between
-// the two steps times the whole target: at a 1.2 rad excursion it named a tool-frame absolute log
-// base frame with flipped signs.) Before the episode's start the rotation is the first step's.
-Pose6 working(const std::vector<Step>& ep, std::size_t t, const std::array<double, kPoseDim>& alpha, int f, Target target, int lag) {
-  const auto scaled = [&](const Pose6& v) {
-    Pose6 y;
-    for (int c = 0; c < kPoseDim; ++c) y[c] = v[c] / alpha[static_cast<std::size_t>(c)];
-    return y;
-  };
-  const auto into = [&](std::size_t back, const Pose6& v) {  // v in the tool frame of step t − back
-    const Mat3& Rt = ep[t >= back ? t - back : 0].R;
-    Pose6 y;
-    y.head<3>() = Rt.transpose() * Vec3(v.head<3>());
-    y.tail<3>() = Rt.transpose() * Vec3(v.tail<3>());
-    return y;
-  };
-  const auto L = static_cast<std::size_t>(lag);
-  if (f == 0) return scaled(ep[t].response);
-  if (target == Target::kDelta) return into(L, scaled(ep[t].response));
-  const Pose6 now = into(L, scaled(ep[t].cumulative));
-  return t == 0 ? now : Pose6(now - into(L + 1, scaled(ep[t - 1].cumulative)));
-}
-
-std::array<double, kPoseDim> isotropic(const std::array<double, kPoseDim>& s) {
-  std::array<double, kPoseDim> o{};
-  for (int g = 0; g < 2; ++g) {
-    double m = 0;
-    for (int c = 3 * g; c < 3 * g + 3; ++c) m += s[static_cast<std::size_t>(c)] * s[static_cast<std::size_t>(c)];
-    for (int c = 3 * g; c < 3 * g + 3; ++c) o[static_cast<std::size_t>(c)] = std::sqrt(m / 3.0);
-  }
-  return o;
-}
-
-// the grammar belief's per-cell evidence, summed over episodes, for both frames; `per_unit` (if
-// given) receives each jackknife unit's share (the cells are sums over steps)
-Cells evidence(const std::vector<std::vector<Step>>& eps, const std::array<double, kPoseDim>& alpha,
-               const std::array<double, kPoseDim>& sigma, std::vector<Cells>* per_unit = nullptr) {
-  Cells E(static_cast<std::size_t>(kFrames * kModes * kPoseDim * kPoseDim * kSK), 0.0);
-  if (per_unit) per_unit->assign(static_cast<std::size_t>(units_of(eps)), Cells(E.size(), 0.0));
-  adapt::ResponseModel unit{{1, 1, 1, 1, 1, 1}, sigma};
-  const auto add = [&](Cells& out, int f, const adapt::GrammarBelief& b, double sign) {
-    for (int m = 0; m < kModes; ++m)
-      for (int i = 0; i < kPoseDim; ++i)
-        for (int j = 0; j < kPoseDim; ++j)
-          for (int sk = 0; sk < kSK; ++sk) out[cidx(f, m, i, j, sk)] += sign * b.evidence(m, i, j, sk / 7, sk % 7);
-  };
-  for (int f = 0; f < kFrames; ++f)
-    for (const auto& ep : eps) {
-      adapt::GrammarBelief b(unit);
-      std::array<Pose6, kModes> y;
-      for (std::size_t t = 0; t < ep.size(); ++t) {
-        if (per_unit && (t == 0 || ep[t].unit != ep[t - 1].unit)) add((*per_unit)[static_cast<std::size_t>(ep[t].unit)], f, b, -1.0);
-        if (f == 0) {
-          b.update(ep[t].raw, working(ep, t, alpha, 0, Target::kDelta, 0));
-        } else {
-          for (int m = 0; m < kModes; ++m) {
-            const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
-            y[static_cast<std::size_t>(m)] = working(ep, t, alpha, 1, mode.target, mode.lag);
-          }
-          b.update_per_mode(ep[t].raw, y);
-        }
-        if (per_unit && (t + 1 == ep.size() || ep[t + 1].unit != ep[t].unit)) add((*per_unit)[static_cast<std::size_t>(ep[t].unit)], f, b, 1.0);
-      }
-      add(E, f, b, 1.0);
-    }
-  return E;
-}
-
-double logsumexp(const double* v, int n) {
-  double m = -std::numeric_limits<double>::infinity();
-  for (int k = 0; k < n; ++k) m = std::max(m, v[k]);
-  double s = 0;
-  for (int k = 0; k < n; ++k) s += std::exp(v[k] - m);
-  return m + std::log(s);
-}
-
-const std::vector<std::array<int, kPoseDim>>& permutations() {
-  static const std::vector<std::array<int, kPoseDim>> all = [] {
-    std::vector<std::array<int, kPoseDim>> v;
-    std::array<int, kPoseDim> p{0, 1, 2, 3, 4, 5};
-    do v.push_back(p);
-    while (std::next_permutation(p.begin(), p.end()));
-    return v;
-  }();
-  return all;
-}
-
-struct Posterior {
-  int frame{0}, mode{0};
-  std::array<int, kPoseDim> perm{};
-  std::array<int, kPoseDim> sk{};           // MAP (sign, scale) index per output channel
-  double p_map_h{0};                         // posterior of the MAP (frame, mode, perm)
-  double p_contract{0};                      // ... times the MAP cells' (sign, scale)
-  std::array<double, kFrames> p_frame{};
-  std::array<double, kModes> p_mode{};
-  std::array<double, kPoseDim> p_perm{};     // P(π_i = π*_i)
-  std::array<double, kPoseDim> p_sign{};
-  std::array<double, kPoseDim> p_scale{};
-  double p_perm_all{0};                      // P(π = π*)
-};
-
-Posterior posterior(const Cells& E) {
-  Posterior P;
-  // L = log Σ_sk exp E per cell
-  std::vector<double> L(static_cast<std::size_t>(kFrames * kModes * kPoseDim * kPoseDim));
-  const auto lidx = [](int f, int m, int i, int j) { return static_cast<std::size_t>(((f * kModes + m) * kPoseDim + i) * kPoseDim + j); };
-  for (int f = 0; f < kFrames; ++f)
-    for (int m = 0; m < kModes; ++m)
-      for (int i = 0; i < kPoseDim; ++i)
-        for (int j = 0; j < kPoseDim; ++j) L[lidx(f, m, i, j)] = logsumexp(&E[cidx(f, m, i, j, 0)], kSK);
-  const auto& perms = permutations();
-  std::vector<double> lw(static_cast<std::size_t>(kFrames * kModes * kPerms));
-  double best = -std::numeric_limits<double>::infinity();
-  std::size_t arg = 0;
-  for (int f = 0; f < kFrames; ++f)
-    for (int m = 0; m < kModes; ++m)
-      for (int p = 0; p < kPerms; ++p) {
-        double s = 0;
-        for (int i = 0; i < kPoseDim; ++i) s += L[lidx(f, m, i, perms[static_cast<std::size_t>(p)][static_cast<std::size_t>(i)])];
-        const std::size_t k = static_cast<std::size_t>((f * kModes + m) * kPerms + p);
-        lw[k] = s;
-        if (s > best) {  // first maximum: base before tool, lower modes first, identity first
-          best = s;
-          arg = k;
-        }
-      }
-  double z = 0;
-  for (double v : lw) z += std::exp(v - best);
-  P.frame = static_cast<int>(arg / (kModes * kPerms));
-  P.mode = static_cast<int>((arg / kPerms) % kModes);
-  P.perm = perms[arg % kPerms];
-  // A[f][m][i][j] = P(f, m, π_i = j)
-  std::vector<double> A(L.size(), 0.0);
-  for (int f = 0; f < kFrames; ++f)
-    for (int m = 0; m < kModes; ++m)
-      for (int p = 0; p < kPerms; ++p) {
-        const std::size_t k = static_cast<std::size_t>((f * kModes + m) * kPerms + p);
-        const double w = std::exp(lw[k] - best) / z;
-        P.p_frame[static_cast<std::size_t>(f)] += w;
-        P.p_mode[static_cast<std::size_t>(m)] += w;
-        const auto& pr = perms[static_cast<std::size_t>(p)];
-        if (pr == P.perm) P.p_perm_all += w;
-        for (int i = 0; i < kPoseDim; ++i) A[lidx(f, m, i, pr[static_cast<std::size_t>(i)])] += w;
-      }
-  P.p_map_h = 1.0 / z;
-  double cells = 1.0;
-  for (int i = 0; i < kPoseDim; ++i) {
-    const auto ii = static_cast<std::size_t>(i);
-    const int j = P.perm[ii];
-    const double* c = &E[cidx(P.frame, P.mode, i, j, 0)];
-    int a = 0;
-    for (int sk = 1; sk < kSK; ++sk)
-      if (c[sk] > c[a]) a = sk;
-    P.sk[ii] = a;
-    cells *= std::exp(c[a] - L[lidx(P.frame, P.mode, i, j)]);
-    double pp = 0, ps = 0, pk = 0;
-    for (int f = 0; f < kFrames; ++f)
-      for (int m = 0; m < kModes; ++m)
-        for (int jj = 0; jj < kPoseDim; ++jj) {
-          const double w = A[lidx(f, m, i, jj)];
-          if (w < 1e-300) continue;
-          if (jj == j) pp += w;
-          const double* cc = &E[cidx(f, m, i, jj, 0)];
-          const double l = L[lidx(f, m, i, jj)];
-          double qs = 0, qk = 0;
-          for (int sk = 0; sk < kSK; ++sk) {
-            const double q = std::exp(cc[sk] - l);
-            if (sk / 7 == a / 7) qs += q;
-            if (sk % 7 == a % 7) qk += q;
-          }
-          ps += w * qs;
-          pk += w * qk;
-        }
-    P.p_perm[ii] = pp;
-    P.p_sign[ii] = ps;
-    P.p_scale[ii] = pk;
-  }
-  P.p_contract = P.p_map_h * cells;
-  return P;
-}
-
-Contract contract_of(const Posterior& P, bool gripper_inverted) {
-  ContractFields f;
-  const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(P.mode)];
-  for (int i = 0; i < kPoseDim; ++i) {
-    const auto ii = static_cast<std::size_t>(i);
-    f.permutation[ii] = P.perm[ii];
-    f.sign[ii] = P.sk[ii] / 7 == 0 ? -1 : 1;
-    f.scale[ii] = grammar::kScaleGrid[static_cast<std::size_t>(P.sk[ii] % 7)];
-  }
-  f.target = to_string(mode.target);
-  f.frame = P.frame == 0 ? "base" : "tool";
-  f.lag = mode.lag;
-  f.gripper_inverted = gripper_inverted;
-  return Contract::make(f);
-}
-
-// per-channel residuals of a contract's replay in the working coordinates
-struct Residuals {
-  std::array<double, kPoseDim> rms{};
-  std::array<double, kPoseDim> rho{};
-};
-
-Residuals residuals(const std::vector<std::vector<Step>>& eps, const std::array<double, kPoseDim>& alpha, const Contract& c) {
-  Residuals r;
-  std::array<double, kPoseDim> ss{}, cross{};
-  std::size_t n = 0;
-  for (const auto& ep : eps) {
-    Pose6 prev = Pose6::Zero();
-    for (std::size_t t = 0; t < ep.size(); ++t) {
-      const Pose6 y = working(ep, t, alpha, c.frame() == Frame::kTool ? 1 : 0, c.target(), c.lag());
-      for (int i = 0; i < kPoseDim; ++i) {
-        const auto ii = static_cast<std::size_t>(i);
-        const double pred = c.sign()[ii] * c.scale()[ii] * drive(ep, t, c.target(), c.lag(), c.permutation()[ii]);
-        const double e = y[i] - pred;
-        ss[ii] += e * e;
-        if (t > 0) cross[ii] += e * prev[i];
-        prev[i] = e;
-      }
-      ++n;
-    }
-  }
-  for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i) {
-    r.rms[i] = std::sqrt(ss[i] / static_cast<double>(std::max<std::size_t>(n, 1)));
-    r.rho[i] = ss[i] > 0 ? cross[i] / ss[i] : 0.0;
-  }
-  return r;
-}
+using detail::Step;
+using detail::drive;
+using detail::working;
 
 // ---- the extension's conventions
 
@@ -618,13 +324,16 @@ double normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   if (const std::string err = validate(o); !err.empty()) throw std::invalid_argument(err);
   validate_log(log);
-  const auto eps = transitions_of(log);
+  const auto eps = detail::transitions_of(log);
   AuditResult R;
   R.source = log.source;
   R.declared = o.declared;
   R.episodes = eps.size();
   R.transitions = log.transitions();
   const double floor = o.confidence_floor;
+  R.committed_raw.fill(-1);
+  R.committed_sign.fill(0);
+  R.scale_committed.fill(false);
 
   // excitation per raw channel
   {
@@ -662,123 +371,72 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   }
   const bool commands = kind == ActionKind::kCommand && kind_decidable;
 
-  // 2. the response model: calibrated, or fitted from the log (best single drive per output channel)
-  std::array<double, kPoseDim> alpha{}, sigma{};
-  if (o.model) {
-    alpha = o.model->alpha;
-    sigma = o.model->sigma;
-  } else {
-    R.model_fitted = true;
-    for (int i = 0; i < kPoseDim; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      double best_explained = -1, best_b = 0, best_res = 0;
-      for (int m = 0; m < kModes; ++m) {
-        const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
-        for (int j = 0; j < kPoseDim; ++j) {
-          double sxy = 0, sxx = 0, syy = 0;
-          for (const auto& ep : eps)
-            for (std::size_t t = 0; t < ep.size(); ++t) {
-              const double x = drive(ep, t, mode.target, mode.lag, j), y = ep[t].response[i];
-              sxy += x * y;
-              sxx += x * x;
-              syy += y * y;
-            }
-          if (sxx <= 0) continue;
-          const double explained = sxy * sxy / sxx;
-          if (explained > best_explained) {
-            best_explained = explained;
-            best_b = sxy / sxx;
-            best_res = std::max(syy - explained, 0.0);
-          }
-        }
-      }
-      alpha[ii] = std::abs(best_b);
-      sigma[ii] = std::sqrt(best_res / static_cast<double>(R.transitions));
-    }
-    // an unexcited channel keeps its group's typical gain, so its evidence is weak rather than undefined
-    for (int g = 0; g < 2; ++g) {
-      double amax = 0, smax = 0;
-      for (int c = 3 * g; c < 3 * g + 3; ++c) {
-        amax = std::max(amax, alpha[static_cast<std::size_t>(c)]);
-        smax = std::max(smax, sigma[static_cast<std::size_t>(c)]);
-      }
-      if (amax <= 0) amax = 1.0;
-      for (int c = 3 * g; c < 3 * g + 3; ++c) {
-        auto& a = alpha[static_cast<std::size_t>(c)];
-        auto& s = sigma[static_cast<std::size_t>(c)];
-        if (a < 1e-3 * amax) a = amax;
-        s = std::max(s, 1e-6 * amax);
-        if (smax > 0) s = std::max(s, 1e-3 * smax);
-      }
-    }
-  }
-  R.alpha = alpha;
-  std::array<double, kPoseDim> sigma_n{};  // calibrated noise in working (normalised) units
-  for (int c = 0; c < kPoseDim; ++c)
-    sigma_n[static_cast<std::size_t>(c)] = sigma[static_cast<std::size_t>(c)] / std::abs(alpha[static_cast<std::size_t>(c)]);
+  // 2. the response model: a calibration's gains, or none (gains then in physical units per command)
+  std::array<double, kPoseDim> alpha{1, 1, 1, 1, 1, 1};
+  if (o.model) alpha = o.model->alpha;
+  R.model_fitted = !o.model;
 
-  // 3. the grammar: two passes, the second with the residual noise scale (inflated for the residuals'
-  // serial correlation), so a log the model describes loosely is not over-trusted
-  Posterior P;
-  Contract map;
-  std::array<double, kPoseDim> sigma_used = isotropic(sigma_n);
-  std::array<double, kPoseDim> fit_terms{};  // per channel: mean squared residual / calibrated variance
-  struct {
-    std::array<bool, kPoseDim> perm{}, sign{};
-    bool frame{false}, target{false}, lag{false};
-  } fragile;  // fields whose MAP changes when one episode is left out
+  // 3. the evidence: which hypotheses the log cannot exclude, and what they agree on
+  detail::Evidence ev;
+  Contract map = o.declared.contract;
+  std::array<double, kPoseDim> sigma_n{};  // noise scale of the best mode's residuals (working units)
+  std::array<double, kPoseDim> perm_conf{}, sign_conf{};
   if (commands) {
-    P = posterior(evidence(eps, alpha, sigma_used));
-    map = contract_of(P, false);
-    const Residuals res = residuals(eps, alpha, map);
-    double ratio = 0;
-    std::array<double, kPoseDim> inflated{};
-    for (int c = 0; c < kPoseDim; ++c) {
-      const auto cc = static_cast<std::size_t>(c);
-      fit_terms[cc] = (res.rms[cc] / sigma_n[cc]) * (res.rms[cc] / sigma_n[cc]);
-      ratio += fit_terms[cc] / kPoseDim;
-      const double rho = std::clamp(res.rho[cc], 0.0, 0.95);
-      inflated[cc] = std::max(sigma_n[cc], res.rms[cc]) * std::sqrt((1 + rho) / (1 - rho));
-    }
-    R.fit_ratio = ratio;
-    const auto iso = isotropic(inflated);
-    R.noise_inflation = std::max(iso[0] / sigma_used[0], iso[3] / sigma_used[3]);
-    sigma_used = iso;
-    std::vector<Cells> shares;
-    Cells E = evidence(eps, alpha, sigma_used, &shares);
-    P = posterior(E);
-    // No single episode decides a field: in a closed loop one episode's contact or oscillation can
-    // outweigh the rest of a short log (on the simulator a lagged contract's rx sign came out backwards
-    // at 200 transitions, carried by one of four episodes). Each field's MAP is recomputed with each
-    // unit (episode, or quarter of a log of fewer than four) left out; a field that changes is not resolved.
-    if (shares.size() >= 2)
-      for (std::size_t u = 0; u < shares.size(); ++u) {
-        for (std::size_t k = 0; k < E.size(); ++k) E[k] -= shares[u][k];
-        const Posterior Q = posterior(E);
-        for (std::size_t k = 0; k < E.size(); ++k) E[k] += shares[u][k];
-        const auto& qm = adapt::GrammarBelief::modes()[static_cast<std::size_t>(Q.mode)];
-        const auto& pm = adapt::GrammarBelief::modes()[static_cast<std::size_t>(P.mode)];
-        for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i) {
-          if (Q.perm[i] != P.perm[i]) fragile.perm[i] = true;
-          if (Q.perm[i] != P.perm[i] || Q.frame != P.frame || Q.sk[i] / 7 != P.sk[i] / 7) fragile.sign[i] = true;
-        }
-        fragile.frame = fragile.frame || Q.frame != P.frame;
-        fragile.target = fragile.target || qm.target != pm.target;
-        fragile.lag = fragile.lag || qm.lag != pm.lag;
-      }
-  }
-
-  // a channel whose source is hardly commanded is not resolved, whatever its posterior: in a closed-loop
-  // log a policy's small corrections answer disturbances, which biases their apparent response
-  if (commands)
+    detail::EvidenceOptions eo;
+    eo.alpha = alpha;
+    eo.calibrated = o.model.has_value();
+    eo.z = floor >= 1.0 ? 40.0 : detail::normal_quantile(floor);
+    eo.min_explained = o.min_explained;
+    eo.min_excitation = o.min_excitation;
+    eo.gain_tolerance = o.gain_tolerance;
+    eo.outlier_z = o.outlier_z;
+    ev = detail::identify(eps, R.excitation, eo);
+    const detail::Mode& bm = ev.modes[static_cast<std::size_t>(ev.best)];
+    ContractFields f;
     for (int i = 0; i < kPoseDim; ++i) {
       const auto ii = static_cast<std::size_t>(i);
-      if (R.excitation[static_cast<std::size_t>(P.perm[ii])] < o.min_excitation) P.p_perm[ii] = P.p_sign[ii] = P.p_scale[ii] = 0.0;
-      if (fragile.perm[ii]) P.p_perm[ii] = 0.0;
-      if (fragile.perm[ii] || fragile.sign[ii]) P.p_sign[ii] = P.p_scale[ii] = 0.0;
+      f.permutation[ii] = ev.map_perm[ii];
+      f.sign[ii] = ev.map_sign[ii];
+      // the identified scale is the log's own gain (calibrated), never rounded onto the grid
+      f.scale[ii] = o.model ? std::max(std::round(ev.map_gain[ii] * 100.0) / 100.0, 0.01) : 1.0;
+      const auto& c = ev.channel[ii];
+      // a committed channel's confidence: its t statistic mapped so that the test's threshold is the floor
+      const double conf = std::abs(c.t) >= ev.t_critical ? 0.5 * std::erfc(-(std::abs(c.t) * eo.z / ev.t_critical) / std::sqrt(2.0)) : 0.0;
+      perm_conf[ii] = c.routed ? std::max(conf, floor) : 0.0;
+      sign_conf[ii] = c.sign_committed ? std::max(conf, floor) : 0.0;
+      if (c.routed) R.committed_raw[ii] = c.raw;
+      if (c.sign_committed) R.committed_sign[ii] = c.sign;
+      sigma_n[ii] = std::max(ev.residual_rms[ii], 1e-12);
     }
+    f.target = to_string(bm.target);
+    f.frame = bm.frame == 0 ? "base" : "tool";
+    f.lag = bm.lag;
+    f.gripper_inverted = o.declared.contract.gripper_inverted();
+    map = Contract::make(f);
+    R.outlier_rows = ev.outlier_rows;
+    R.evidence_t = ev.null_t;
+    R.t_critical = ev.t_critical;
+    int plausible = 0;
+    for (bool p : ev.plausible) plausible += p ? 1 : 0;
+    R.plausible_modes = plausible;
+    // misspecification (calibrated model only): the best mode's residual against the calibrated noise
+    if (o.model) {
+      double ratio = 0;
+      for (int c = 0; c < kPoseDim; ++c) {
+        const double s = o.model->sigma[static_cast<std::size_t>(c)] / std::abs(alpha[static_cast<std::size_t>(c)]);
+        ratio += std::pow(ev.residual_rms[static_cast<std::size_t>(c)] / s, 2) / kPoseDim;
+      }
+      R.fit_ratio = ratio;
+      double infl = 0;
+      for (int c = 0; c < kPoseDim; ++c) {
+        const double s = o.model->sigma[static_cast<std::size_t>(c)] / std::abs(alpha[static_cast<std::size_t>(c)]);
+        infl = std::max(infl, ev.residual_rms[static_cast<std::size_t>(c)] / s);
+      }
+      R.noise_inflation = std::max(infl, 1.0);
+    }
+  }
 
-  // 4. the gripper: range from the numbers, polarity from the fingers (lag of the grammar's MAP)
+  // 4. the gripper: range from the numbers, polarity from the fingers (the best mode's lag)
   GripperRange range = o.declared.gripper_range;
   double range_conf = 0;
   std::string range_reason;
@@ -786,10 +444,10 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   double polarity_conf = 0;
   std::string polarity_reason;
   bool polarity_checked = log.has_gripper;
-  const int map_lag = commands ? adapt::GrammarBelief::modes()[static_cast<std::size_t>(P.mode)].lag : 0;
+  const int map_lag = commands ? map.lag() : 0;
   if (log.has_gripper) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    std::size_t n_lo = 0, n_hi = 0, n = 0;
+    std::size_t n_lo = 0, n_hi = 0;
     for (const auto& ep : eps)
       for (const auto& s : ep) {
         const double g = s.raw[kGripper];
@@ -797,7 +455,6 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         hi = std::max(hi, g);
         n_lo += g < 0.1;
         n_hi += g > 0.9;
-        ++n;
       }
     if (hi - lo < 0.1) {
       range_reason = "the gripper command never changes; a log that opens and closes the gripper would decide";
@@ -833,8 +490,15 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     } else {
       const double mn = static_cast<double>(m);
       const double vx = sxx - sx * sx / mn, cxy = sxy - sx * sy / mn, vy = syy - sy * sy / mn;
+      // finger positions that never move carry no polarity (a zero slope over a zero standard error is
+      // not evidence): the field is then not checked
+      const double finger_sd = std::sqrt(std::max(vy, 0.0) / mn);
       if (vx <= 1e-12 * mn) {
         polarity_reason = "the gripper command never changes; a log that opens and closes the gripper would decide";
+      } else if (finger_sd < 1e-5) {
+        polarity_checked = false;
+        polarity_reason = "the finger positions never move in the log (SD " + fmt("%.2g", finger_sd) +
+                          " m): they carry no polarity; a log whose fingers follow the gripper would decide";
       } else {
         const double b = cxy / vx;
         const double res = std::max(vy - b * cxy, 0.0) / std::max(mn - 2, 1.0);
@@ -843,10 +507,10 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         for (const auto& ep : eps)
           for (std::size_t t = 1; t < ep.size(); ++t) changes += std::abs(ep[t].raw[kGripper] - ep[t - 1].raw[kGripper]) > 0.1;
         const double se = std::sqrt(res / vx) * std::sqrt(mn / static_cast<double>(std::min(changes, m)));
-        const double z = se > 0 ? b / se : (b > 0 ? 1e9 : -1e9);
+        const double z = se > 0 ? b / se : 0.0;
         const double p_not = normal_cdf(z);
         inverted = p_not < 0.5;
-        polarity_conf = std::max(p_not, 1 - p_not);
+        polarity_conf = se > 0 ? std::max(p_not, 1 - p_not) : 0.0;
         if (polarity_conf < floor)
           polarity_reason = "the fingers follow the gripper command too weakly; more open and close commands would decide";
       }
@@ -859,41 +523,46 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   // 5. the identified conventions
   Conventions id = o.declared;
   id.action = kind_decidable ? kind : o.declared.action;
-  if (commands) {
-    map = contract_of(P, polarity_checked && polarity_conf > 0 ? inverted : o.declared.contract.gripper_inverted());
+  {
+    auto f = map.fields();
+    f.gripper_inverted = polarity_checked && polarity_conf > 0 ? inverted : o.declared.contract.gripper_inverted();
+    map = Contract::make(f);
     id.contract = map;
-    R.map_posterior = P.p_contract;
+  }
+  if (commands)
     for (int i = 0; i < kPoseDim; ++i) {
       const auto ii = static_cast<std::size_t>(i);
-      R.effective_gain[ii] = alpha[ii] * map.sign()[ii] * map.scale()[ii];
+      R.effective_gain[ii] = alpha[ii] * ev.map_sign[ii] * ev.map_gain[ii];
+      if (!o.model) R.alpha[ii] = ev.map_gain[ii];
+      else R.alpha[ii] = alpha[ii];
     }
-  } else {
-    auto f = o.declared.contract.fields();
-    f.gripper_inverted = polarity_checked && polarity_conf > 0 ? inverted : o.declared.contract.gripper_inverted();
-    id.contract = Contract::make(f);
-  }
   id.gripper_range = range_conf > 0 ? range : o.declared.gripper_range;
   std::array<double, 3> rep_p{1.0 / 3, 1.0 / 3, 1.0 / 3};
   double rep_separation = 0;
   if (commands) {
-    std::array<double, kPoseDim> s_phys{};
-    for (int c = 0; c < kPoseDim; ++c) s_phys[static_cast<std::size_t>(c)] = sigma_used[static_cast<std::size_t>(c)];
     std::array<std::array<double, 3>, 3> sq{};
-    rep_p = rotation_rep_posterior(eps, alpha, s_phys, map, &rep_separation, &sq);
+    // the replay of the rotation channels at the log's own gains (working units of alpha)
+    auto rf = map.fields();
+    for (int i = 0; i < kPoseDim; ++i) rf.scale[static_cast<std::size_t>(i)] = std::max(ev.map_gain[static_cast<std::size_t>(i)], 1e-9);
+    rep_p = rotation_rep_posterior(eps, alpha, sigma_n, Contract::make(rf), &rep_separation, &sq);
     int best = 0;
     for (int r = 1; r < 3; ++r)
       if (rep_p[static_cast<std::size_t>(r)] > rep_p[static_cast<std::size_t>(best)]) best = r;
     id.rotation = static_cast<RotationRep>(best);
-    // the fit of the rotation channels under the identified representation (the grammar's linear
-    // replay above has the other representations' second-order terms in its residual)
-    double ratio = 0;
-    for (int c = 0; c < 3; ++c) ratio += fit_terms[static_cast<std::size_t>(c)];
-    for (int c = 0; c < 3; ++c) {
-      const auto cc = static_cast<std::size_t>(c + 3);
-      const double rms = std::sqrt(sq[static_cast<std::size_t>(best)][static_cast<std::size_t>(c)] / static_cast<double>(R.transitions)) / std::abs(alpha[cc]);
-      ratio += std::min(fit_terms[cc], (rms / sigma_n[cc]) * (rms / sigma_n[cc]));
+    // the misspecification ratio with the rotation channels under the identified representation (the
+    // linear fit has the other representations' second-order terms in its residual)
+    if (o.model) {
+      double ratio = 0;
+      for (int c = 0; c < kPoseDim; ++c) {
+        const auto cc = static_cast<std::size_t>(c);
+        const double s = o.model->sigma[cc] / std::abs(alpha[cc]);
+        double rms = ev.residual_rms[cc];
+        if (c >= 3 && R.committed_sign[3] != 0 && R.committed_sign[4] != 0 && R.committed_sign[5] != 0)
+          rms = std::min(rms, std::sqrt(sq[static_cast<std::size_t>(best)][cc - 3] / static_cast<double>(R.transitions)) / std::abs(alpha[cc]));
+        ratio += std::pow(rms / s, 2) / kPoseDim;
+      }
+      R.fit_ratio = ratio;
     }
-    R.fit_ratio = ratio / kPoseDim;
   }
   R.identified = id;
 
@@ -902,6 +571,10 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   const std::string not_commands =
       kind_decidable ? "the logged actions are poses, not commands of the grammar"
                      : "the TCP does not move in the log: nothing responds to the commands";
+  const std::string no_evidence =
+      "the logged actions do not explain the logged motion: under every hypothesis searched, a fit that leaves out one "
+      "episode predicts it no better than ignoring the actions (paired t = " + fmt("%.2f", ev.null_t) + ", " +
+      fmt("%.2f", ev.t_critical) + " needed); check that actions and poses are aligned row by row";
   const auto per_channel = [&](Field f, const std::array<double, kPoseDim>& conf) {
     AuditField a;
     a.name = to_string(f);
@@ -912,14 +585,20 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
       a.reason = not_commands;
       return a;
     }
-    a.confidence = 1.0;
+    // the confidence of a per-channel field is its weakest resolved channel's (0 when none is)
+    double weakest = 1.0;
+    bool any = false;
     for (int i = 0; i < kPoseDim; ++i) {
       const auto ii = static_cast<std::size_t>(i);
-      a.confidence = std::min(a.confidence, conf[ii]);
-      if (conf[ii] < floor) a.unresolved_channels.push_back(i);
+      if (conf[ii] < floor) {
+        a.unresolved_channels.push_back(i);
+      } else {
+        weakest = std::min(weakest, conf[ii]);
+        any = true;
+      }
     }
+    a.confidence = any ? weakest : 0.0;
     a.resolved = a.unresolved_channels.empty();
-    // identified value, "?" on unresolved channels; diff over resolved channels
     std::vector<std::string> parts, diffs;
     for (int i = 0; i < kPoseDim; ++i) {
       const auto ii = static_cast<std::size_t>(i);
@@ -928,124 +607,96 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
       if (f == Field::kPermutation) {
         v = std::to_string(map.permutation()[ii]);
         dv = std::to_string(dc.permutation()[ii]);
-      } else if (f == Field::kSign) {
+      } else {
         v = std::to_string(map.sign()[ii]);
         dv = std::to_string(dc.sign()[ii]);
-      } else {
-        v = python_float_repr(map.scale()[ii]);
-        dv = python_float_repr(dc.scale()[ii]);
       }
       parts.push_back(ok ? v : "?");
       if (ok && v != dv) {
         if (f == Field::kPermutation)
           diffs.push_back("output channel " + std::to_string(i) + " (" + kChannel[i] + ") reads raw channel " + v + ", declared " + dv);
-        else if (f == Field::kSign)
-          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") sign FLIPPED");
         else
-          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") scale " + dv + "->" + v +
-                          (R.model_fitted ? " (relative to the fitted gain)" : ""));
+          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") sign FLIPPED");
       }
     }
     a.identified = "(" + join(parts, ", ") + ")";
-    if (a.resolved && f != Field::kScale) {
-      a.diff = diff_sentence(dc, map, f);
-    } else {
-      a.diff = join(diffs, "; ");
-    }
-    if (f == Field::kScale && a.resolved) a.diff = join(diffs, "; ");
+    a.diff = a.resolved ? diff_sentence(dc, map, f) : join(diffs, "; ");
+    if (a.resolved && a.diff.empty()) a.diff = join(diffs, "; ");
     if (!a.resolved) {
-      std::vector<int> raw;
-      for (int i : a.unresolved_channels) raw.push_back(map.permutation()[static_cast<std::size_t>(i)]);
-      std::string weak;
-      for (int j = 0; j < kPoseDim; ++j)
-        if (R.excitation[static_cast<std::size_t>(j)] < o.min_excitation) weak += (weak.empty() ? "" : ", ") + std::to_string(j);
-      a.reason = "not resolved on output channel(s) " + channel_list(a.unresolved_channels) +
-                 (weak.empty() ? "" : "; raw channel(s) " + weak + " hardly move (RMS command < " + fmt("%g", o.min_excitation) + ")") +
-                 "; a log that commands every channel, positive and negative, on its own and in reversals, would decide";
-      if (f == Field::kSign || f == Field::kPermutation)
+      std::vector<std::string> why;
+      for (int i : a.unresolved_channels) {
+        const auto& c = ev.channel[static_cast<std::size_t>(i)];
+        std::string w = f == Field::kSign && c.routed && !c.sign_committed ? c.why : c.why;
+        if (w.empty()) w = "its routing is not committed";
+        why.push_back(std::string(kChannel[i]) + ": " + w);
+      }
+      a.reason = "not resolved on output channel(s) " + channel_list(a.unresolved_channels) + " (" + join(why, "; ") +
+                 "); a log that commands every channel, positive and negative, on its own and in reversals, would decide";
+      if (!ev.frame_resolved)
         a.reason += "; with the TCP orientation nearly constant, a tool-frame contract equals a base-frame one with other signs and channels, so also rotate the TCP";
-      std::vector<int> one;
-      for (int i : a.unresolved_channels)
-        if (fragile.perm[static_cast<std::size_t>(i)] || (f != Field::kPermutation && fragile.sign[static_cast<std::size_t>(i)])) one.push_back(i);
-      if (!one.empty())
-        a.reason += "; on channel(s) " + channel_list(one) + " one episode decides (leaving it out changes the answer): more episodes would decide";
     }
     return a;
   };
-  R.fields.push_back(per_channel(Field::kPermutation, P.p_perm));
-  R.fields.push_back(per_channel(Field::kSign, P.p_sign));
+  if (commands && !ev.evidence) {
+    perm_conf.fill(0.0);
+    sign_conf.fill(0.0);
+  }
+  R.fields.push_back(per_channel(Field::kPermutation, perm_conf));
+  R.fields.push_back(per_channel(Field::kSign, sign_conf));
   {
-    AuditField s = per_channel(Field::kScale, P.p_scale);
-    if (commands && !R.model_fitted) {
+    AuditField s;
+    s.name = "scale";
+    s.declared = field_value(dc, Field::kScale);
+    if (!commands) {
+      s.checked = false;
+      s.identified = s.declared;
+      s.reason = not_commands;
+    } else if (!o.model) {
+      s.checked = false;
+      std::vector<std::string> g;
+      for (double x : ev.map_gain) g.push_back(fmt("%.3g", x));
+      s.identified = "(" + join(g, ", ") + ")";
+      s.reason = "scale unchecked: without a response calibration (--task or --calibration) a log cannot separate the "
+                 "contract's scale from the robot's response gain; the identified values are the log's gains per unit command";
+    } else {
       // The calibrated gain describes the calibration's motion (random walks); a log's motion runs at
-      // another gain (sustained commands, contacts), so a channel's scale is the set of grid values
-      // within the gain tolerance of the log's least-squares gain / calibrated gain (widened by two
-      // standard errors). The declaration agrees if its scale is in that band; it differs if the
-      // channel's routing is resolved and its declared scale is outside the band.
-      const int f = map.frame() == Frame::kTool ? 1 : 0;
+      // another gain (sustained commands, saturation, contacts), so a channel's scale is only known to
+      // lie in a band: the log's gain / calibrated gain within the gain tolerance, widened by two
+      // jackknife standard errors. The declaration agrees if its scale is in that band and differs if
+      // it is outside; the band is what is reported, never the nearest grid scale.
       std::vector<std::string> parts, diffs;
-      s.unresolved_channels.clear();
       s.confidence = 1.0;
+      bool any = false;
       for (int i = 0; i < kPoseDim; ++i) {
         const auto ii = static_cast<std::size_t>(i);
-        double sxy = 0, sxx = 0;
-        std::vector<double> uxy(static_cast<std::size_t>(units_of(eps)), 0.0), uxx(uxy.size(), 0.0);
-        for (const auto& ep : eps)
-          for (std::size_t t = 0; t < ep.size(); ++t) {
-            const double d = drive(ep, t, map.target(), map.lag(), map.permutation()[ii]);
-            const double xy = working(ep, t, alpha, f, map.target(), map.lag())[i] * d;
-            sxy += xy;
-            sxx += d * d;
-            uxy[static_cast<std::size_t>(ep[t].unit)] += xy;
-            uxx[static_cast<std::size_t>(ep[t].unit)] += d * d;
-          }
-        const double g = sxx > 0 ? std::abs(sxy / sxx) : 0.0;
-        // the standard error: the noise model's, or the jackknife's over episodes if larger (a closed
-        // loop's episodes run at different gains: contacts, oscillations under a lag)
-        double se = sxx > 0 ? sigma_used[ii] / std::sqrt(sxx) : std::numeric_limits<double>::infinity();
-        if (uxy.size() >= 2 && sxx > 0) {
-          std::vector<double> gu;
-          for (std::size_t u = 0; u < uxy.size(); ++u)
-            if (sxx - uxx[u] > 0) gu.push_back(std::abs((sxy - uxy[u]) / (sxx - uxx[u])));
-          if (gu.size() == uxy.size()) {
-            double mean = 0, ss = 0;
-            for (double x : gu) mean += x / static_cast<double>(gu.size());
-            for (double x : gu) ss += (x - mean) * (x - mean);
-            se = std::max(se, std::sqrt(ss * static_cast<double>(gu.size() - 1) / static_cast<double>(gu.size())));
-          } else {
-            se = std::numeric_limits<double>::infinity();  // one unit carries all of the channel's drive
-          }
-        }
-        const double lo = g / o.gain_tolerance - 2 * se, hi = g * o.gain_tolerance + 2 * se;
-        R.scale_band[ii] = {std::max(lo, 0.0), hi};
-        std::vector<std::string> in;
-        for (double k : grammar::kScaleGrid)
-          if (k >= lo && k <= hi) in.push_back(python_float_repr(k));
-        const bool routed = P.p_perm[ii] >= floor && P.p_sign[ii] >= floor;
-        const bool ok = routed && !in.empty() && in.size() < grammar::kScaleGrid.size();
+        const auto& c = ev.channel[ii];
+        const double g = c.gain, se = c.gain_se;
+        const double lo = std::max(g / o.gain_tolerance - 2 * se, 0.0), hi = g * o.gain_tolerance + 2 * se;
+        R.scale_band[ii] = {lo, hi};
+        bool on_grid = false;
+        for (double k : grammar::kScaleGrid) on_grid = on_grid || (k >= lo && k <= hi);
+        const bool ok = ev.evidence && c.sign_committed && std::isfinite(hi);
         if (!ok) {
           s.unresolved_channels.push_back(i);
-          s.confidence = 0.0;
+          parts.push_back("?");
+          continue;
         }
-        parts.push_back(ok ? join(in, "|") : "?");
+        any = true;
+        R.scale_committed[ii] = true;
+        const std::string band = "[" + fmt("%.2g", lo) + ", " + fmt("%.2g", hi) + "]";
+        parts.push_back(on_grid ? band : "~" + fmt("%.2g", g) + " (outside the grammar)");
         const double dk = dc.scale()[ii];
-        if (ok && !(dk >= lo && dk <= hi))
-          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") scale " + python_float_repr(dk) + "->" + join(in, " or ") +
-                          " (the log's gain is " + fmt("%.2f", g) + "x the calibrated one)");
+        if (!(dk >= lo && dk <= hi))
+          diffs.push_back("channel " + std::to_string(i) + " (" + kChannel[i] + ") scale " + python_float_repr(dk) + " is outside the log's band " + band +
+                          " (its gain is " + fmt("%.2f", g) + "x the calibrated one" + (on_grid ? "" : "; no scale of the grammar is in the band") + ")");
       }
+      s.confidence = any ? floor : 0.0;
       s.identified = "(" + join(parts, ", ") + ")";
       s.resolved = s.unresolved_channels.empty();
       s.diff = join(diffs, "; ");
-      s.reason.clear();
       if (!s.resolved)
         s.reason = "not resolved on output channel(s) " + channel_list(s.unresolved_channels) +
-                   ": their routing is not resolved, or the log's gain fits no grid scale or every one within the gain tolerance x" +
-                   fmt("%.2f", o.gain_tolerance) + "; longer motion on those channels would decide";
-    }
-    if (R.model_fitted && commands) {
-      s.checked = false;
-      s.reason = "no response calibration: a log cannot separate the contract's scale from the robot's response gain; "
-                 "scales are relative to the gain fitted from this log (effective gains per output channel in the report)";
+                   ": their routing and sign are not committed; longer motion on those channels would decide";
     }
     R.fields.push_back(std::move(s));
   }
@@ -1062,40 +713,60 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     if (!a.resolved) a.reason = std::move(reason);
     return a;
   };
-  const auto& mode = adapt::GrammarBelief::modes()[static_cast<std::size_t>(P.mode)];
-  double p_target = 0, p_lag = 0;
-  for (int m = 0; m < kModes; ++m) {
-    const auto& mm = adapt::GrammarBelief::modes()[static_cast<std::size_t>(m)];
-    if (mm.target == mode.target) p_target += P.p_mode[static_cast<std::size_t>(m)];
-    if (mm.lag == mode.lag) p_lag += P.p_mode[static_cast<std::size_t>(m)];
-  }
-  R.fields.push_back(scalar("target", to_string(dc.target()), commands ? to_string(map.target()) : to_string(dc.target()), p_target,
-                            commands, commands ? "delta and absolute targets are not told apart; commands that change from step to step (reversals) would decide" : not_commands,
-                            "target encoding differs: declared " + std::string(to_string(dc.target())) + ", the log is " + to_string(map.target())));
-  // a scalar field that one episode decides is not resolved
-  const auto unless_fragile = [&](bool is_fragile) {
-    AuditField& a = R.fields.back();
-    if (!is_fragile || !a.resolved) return;
-    a.resolved = false;
-    a.diff.clear();
-    a.reason = "one episode decides it (leaving it out changes the answer); more episodes would decide";
+  // which modes the log cannot exclude, in words (for the reasons)
+  const auto rivals = [&](auto differs) {
+    std::vector<std::string> v;
+    for (std::size_t k = 0; k < ev.modes.size(); ++k)
+      if (ev.plausible[k] && differs(ev.modes[k])) v.push_back(std::string(to_string(ev.modes[k].target)) + "/" + (ev.modes[k].frame ? "tool" : "base") + "/lag " + std::to_string(ev.modes[k].lag));
+    if (v.size() > 4) {
+      const auto n = v.size();
+      v.resize(4);
+      v.push_back("... (" + std::to_string(n) + " in all)");
+    }
+    return join(v, ", ");
   };
-  unless_fragile(fragile.target);
+  const detail::Mode bm = commands ? ev.modes[static_cast<std::size_t>(ev.best)] : detail::Mode{};
+  const std::string unresolved_prefix = commands && !ev.evidence ? no_evidence : "";
+  // a scalar field's confidence: its weakest paired t mapped so that the test's threshold is the floor
+  const auto conf_of = [&](bool resolved, double t) {
+    if (!(commands && ev.evidence && resolved)) return 0.0;
+    const double z = floor >= 1.0 ? 40.0 : detail::normal_quantile(floor);
+    return std::max(floor, normal_cdf(std::min(t, 1e6) * z / ev.t_critical));
+  };
+  R.fields.push_back(scalar("target", to_string(dc.target()), commands ? to_string(map.target()) : to_string(dc.target()),
+                            conf_of(ev.target_resolved, ev.target_t), commands,
+                            !commands ? not_commands
+                            : !ev.evidence ? no_evidence
+                                           : "delta and absolute targets are not told apart (the log cannot exclude " +
+                                                 rivals([&](const detail::Mode& m) { return m.target != bm.target; }) +
+                                                 "); commands that change from step to step (reversals) would decide",
+                            "target encoding differs: declared " + std::string(to_string(dc.target())) + ", the log is " + to_string(map.target())));
   double spread = 0;
   for (const auto& ep : eps)
     for (const auto& s : ep) spread = std::max(spread, Eigen::AngleAxisd(eps.front().front().R.transpose() * s.R).angle());
   R.fields.push_back(scalar("frame", to_string(dc.frame()), commands ? to_string(map.frame()) : to_string(dc.frame()),
-                            P.p_frame[static_cast<std::size_t>(P.frame)], commands,
-                            commands ? "base and tool frames are not told apart (the TCP orientation varies by " + fmt("%.2f", spread) +
-                                           " rad over the log); a log in which the TCP turns by at least " + fmt("%.1f", std::max(o.min_rotation_spread, 0.2)) +
-                                           " rad while translating would decide"
-                                     : not_commands,
+                            conf_of(ev.frame_resolved, ev.frame_t), commands,
+                            !commands ? not_commands
+                            : !ev.evidence ? no_evidence
+                                           : "base and tool frames are not told apart (the TCP orientation varies by " + fmt("%.2f", spread) +
+                                                 " rad over the log); a log in which the TCP turns by at least " + fmt("%.1f", std::max(o.min_rotation_spread, 0.2)) +
+                                                 " rad while translating would decide",
                             "reference frame differs: declared " + std::string(to_string(dc.frame())) + ", the log is " + to_string(map.frame())));
-  unless_fragile(fragile.frame);
-  R.fields.push_back(scalar("lag", std::to_string(dc.lag()), commands ? std::to_string(map.lag()) : std::to_string(dc.lag()), p_lag, commands,
-                            commands ? "the actuation lag is not resolved; commands that change abruptly (steps, reversals) would decide" : not_commands,
-                            "actuation lag differs: declared " + std::to_string(dc.lag()) + " step(s), the log shows " + std::to_string(map.lag()) + " step(s)"));
-  unless_fragile(fragile.lag);
+  {
+    bool on_grid = false;
+    for (int g : grammar::kLagGrid) on_grid = on_grid || map.lag() == g;
+    const std::string lag_text = std::to_string(map.lag()) + (commands && !on_grid ? " (outside the grammar)" : "");
+    const std::string declared_text = std::to_string(dc.lag()) + (std::find(grammar::kLagGrid.begin(), grammar::kLagGrid.end(), dc.lag()) == grammar::kLagGrid.end() ? " (outside the grammar)" : "");
+    R.fields.push_back(scalar("lag", declared_text, commands ? lag_text : declared_text, conf_of(ev.lag_resolved, ev.lag_t), commands,
+                              !commands ? not_commands
+                              : !ev.evidence ? no_evidence
+                                             : "the actuation lag is not resolved (the log cannot exclude " +
+                                                   rivals([&](const detail::Mode& m) { return m.lag != bm.lag; }) +
+                                                   "); commands that change abruptly (steps, reversals) would decide",
+                              "actuation lag differs: declared " + std::to_string(dc.lag()) + " step(s), the log shows " + std::to_string(map.lag()) +
+                                  " step(s)" + (on_grid ? "" : ", outside the grammar's lags {0, 1, 2, 4}")));
+  }
+  (void)unresolved_prefix;
   const auto grip_words = [](bool inv) { return std::string(inv ? "inverted (+1 closes)" : "not inverted (+1 opens)"); };
   R.fields.push_back(scalar("gripper_inverted", grip_words(dc.gripper_inverted()), grip_words(id.contract.gripper_inverted()),
                             polarity_conf, polarity_checked, polarity_reason,
@@ -1111,11 +782,14 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     // a perfect fit could not reach the floor (expected log-odds below log(floor / (1 - floor))), the
     // log cannot tell them apart, and the field is not checked rather than unresolved
     const double needed = 2.0 * std::log(std::max(floor, 0.5) / std::max(1.0 - floor, 1e-12));
-    const bool rep_checkable = commands && rep_separation >= needed;
+    // checked only where the rotation channels' routing and sign are committed (the replay needs them)
+    bool rot_committed = true;
+    for (int c = 3; c < kPoseDim; ++c) rot_committed = rot_committed && R.committed_sign[static_cast<std::size_t>(c)] != 0;
+    const bool rep_checkable = commands && ev.evidence && rot_committed && rep_separation >= needed;
     R.fields.push_back(scalar("rotation", to_string(o.declared.rotation), rep_checkable ? to_string(id.rotation) : to_string(o.declared.rotation),
                               rep_checkable ? conf : 0.0, rep_checkable,
-                              commands ? "the rotation representations differ only at second order (half the cross products of the angles): "
-                                         "the log's rotations separate them by " + fmt("%.2g", rep_separation) + " (squared noise units; " +
+                              commands ? "the log cannot tell the rotation representations apart: they differ only at second order (half the cross products "
+                                         "of the angles), and the log's rotations separate them by " + fmt("%.2g", rep_separation) + " (squared noise units; " +
                                          fmt("%.2g", needed) + " needed); simultaneous rotation commands on two or more axes, well above the noise, would decide"
                                        : not_commands,
                               "rotation representation differs: declared " + describe(o.declared.rotation) + ", the log's rotation deltas are " +
@@ -1124,29 +798,47 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   R.fields.push_back(scalar("action", to_string(o.declared.action), to_string(id.action), kind_conf, true,
                             "the TCP does not move in the log, so the actions cannot be compared with the poses",
                             "the logged action differs: declared " + action_words(o.declared.action) + ", the log's action is " + action_words(id.action)));
-
-  // 7. the verdict (the self-test's rules, per field and channel)
-  std::vector<std::string> diffs, unresolved;
-  for (const auto& f : R.fields) {
-    if (!f.checked) continue;
-    if (!f.diff.empty()) diffs.push_back(f.diff);
-    if (!f.resolved) unresolved.push_back(f.name);
+  if (commands && ev.evidence) {
+    if (ev.target_resolved) R.committed_target = to_string(map.target());
+    if (ev.frame_resolved) R.committed_frame = to_string(map.frame());
+    if (ev.lag_resolved) R.committed_lag = map.lag();
   }
-  if (commands && R.fit_ratio > o.misspec_ratio) {
+  if (const AuditField* g = R.field("gripper_inverted"); g && g->checked && g->resolved) R.committed_gripper_inverted = id.contract.gripper_inverted();
+
+  // 7. the verdict
+  std::vector<std::string> diffs, unresolved, unchecked;
+  for (const auto& f : R.fields) {
+    if (!f.checked) {
+      if (f.name != "gripper_range") unchecked.push_back(f.name);
+      continue;
+    }
+    if (!f.diff.empty()) diffs.push_back(f.diff);
+    if (!f.resolved) {
+      if (f.unresolved_channels.empty() || f.unresolved_channels.size() == static_cast<std::size_t>(kPoseDim))
+        unresolved.push_back(f.name);
+      else
+        unresolved.push_back(f.name + " on channel(s) " + channel_list(f.unresolved_channels));
+    }
+  }
+  if (commands && !ev.evidence) {
     R.status = Status::kInconclusive;
-    R.reason = "response misspecification: the best contract of the grammar fits the log at " + fmt("%.1f", R.fit_ratio) +
+    R.reason = "no evidence: " + no_evidence + ". Abstaining.";
+  } else if (commands && o.model && R.fit_ratio > o.misspec_ratio) {
+    R.status = Status::kInconclusive;
+    R.reason = "response misspecification: the best hypothesis fits the log at " + fmt("%.1f", R.fit_ratio) +
                "x the calibrated noise variance (threshold " + fmt("%.1f", o.misspec_ratio) +
                "x): the log's controller or response is outside what the grammar and calibration describe. Abstaining.";
   } else if (!diffs.empty()) {
     R.status = Status::kMismatch;
     R.reason = join(diffs, "; ");
-    if (!unresolved.empty()) R.reason += " (note: field(s) [" + join(unresolved, ", ") + "] not resolved and not part of this verdict)";
+    if (!unresolved.empty()) R.reason += " (not decided by this log, and not part of this verdict: " + join(unresolved, "; ") + ")";
   } else if (!unresolved.empty()) {
     R.status = Status::kInconclusive;
-    R.reason = "the log does not decide field(s) [" + join(unresolved, ", ") + "]. Abstaining rather than guessing.";
+    R.reason = "the log does not decide " + join(unresolved, "; ") + "; what it decides agrees with the declaration. Abstaining rather than guessing.";
   } else {
     R.status = Status::kPass;
     R.reason = "every checked field resolved and agrees with the declaration";
+    if (!unchecked.empty()) R.reason += "; the log cannot check " + join(unchecked, ", ") + " (see below)";
   }
   return R;
 }
@@ -1162,7 +854,6 @@ nlohmann::json to_json_value(const AuditResult& r) {
   j["declared"] = r.declared.to_json_value();
   j["identified"] = r.identified.to_json_value();
   j["identified_contract_sha256"] = r.identified.contract.sha256();
-  j["map_posterior"] = r.map_posterior;
   j["fit_ratio"] = r.fit_ratio;
   j["noise_inflation"] = r.noise_inflation;
   j["model_fitted"] = r.model_fitted;
@@ -1172,6 +863,27 @@ nlohmann::json to_json_value(const AuditResult& r) {
   j["excitation"] = r.excitation;
   j["episodes"] = r.episodes;
   j["transitions"] = r.transitions;
+  j["outlier_rows"] = r.outlier_rows;
+  j["evidence_t"] = r.evidence_t;
+  j["t_critical"] = r.t_critical;
+  j["plausible_hypotheses"] = r.plausible_modes;
+  {
+    // what the verdict commits to, per field (null: not committed), for programs that score audits
+    nlohmann::json c;
+    c["permutation"] = nlohmann::json::array();
+    c["sign"] = nlohmann::json::array();
+    c["scale_band"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i) {
+      c["permutation"].push_back(r.committed_raw[i] >= 0 ? nlohmann::json(r.committed_raw[i]) : nlohmann::json());
+      c["sign"].push_back(r.committed_sign[i] != 0 ? nlohmann::json(r.committed_sign[i]) : nlohmann::json());
+      c["scale_band"].push_back(r.scale_committed[i] ? nlohmann::json(r.scale_band[i]) : nlohmann::json());
+    }
+    c["target"] = r.committed_target ? nlohmann::json(*r.committed_target) : nlohmann::json();
+    c["frame"] = r.committed_frame ? nlohmann::json(*r.committed_frame) : nlohmann::json();
+    c["lag"] = r.committed_lag ? nlohmann::json(*r.committed_lag) : nlohmann::json();
+    c["gripper_inverted"] = r.committed_gripper_inverted ? nlohmann::json(*r.committed_gripper_inverted) : nlohmann::json();
+    j["committed"] = c;
+  }
   nlohmann::json fields = nlohmann::json::object();
   for (const auto& f : r.fields) {
     nlohmann::json x;
@@ -1211,11 +923,13 @@ std::string to_text(const AuditResult& r) {
       any = true;
       s << "  " << f.name << ": " << f.reason << "\n";
     }
-  s << "\nIdentified contract (MAP over the grammar, posterior " << fmt("%.4g", r.map_posterior) << "): " << r.identified.contract.to_json() << "\n";
-  s << "Effective gain per output channel (response per unit command):";
+  s << "\nBest hypothesis (only the resolved fields above are claimed): " << r.identified.contract.to_json() << "\n";
+  s << "Gain per output channel (response per unit command" << (r.model_fitted ? ", physical units" : ", x the calibrated gain") << "):";
   for (double g : r.effective_gain) s << " " << fmt("%.4g", g);
-  s << "\nFit: " << fmt("%.2f", r.fit_ratio) << "x the " << (r.model_fitted ? "fitted" : "calibrated")
-    << " noise variance; posterior computed with the noise scale x" << fmt("%.2f", r.noise_inflation) << "\n";
+  s << "\nEvidence: the actions explain the motion at paired t = " << fmt("%.2f", r.evidence_t) << " (threshold " << fmt("%.2f", r.t_critical)
+    << "); " << r.plausible_modes << " of the searched (target, frame, lag) hypotheses not excluded; " << r.outlier_rows << " row(s) left out as outliers";
+  if (!r.model_fitted) s << "; fit " << fmt("%.2f", r.fit_ratio) << "x the calibrated noise variance";
+  s << "\n";
   s << "Command RMS per raw channel:";
   for (double g : r.excitation) s << " " << fmt("%.3f", g);
   s << "\n";

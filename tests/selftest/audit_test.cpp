@@ -12,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -41,6 +42,23 @@ AuditResult run(const Conventions& truth, const Conventions& declared, Synthetic
   return audit(log, o);
 }
 
+// The identified contract is the truth in every field but scale, which is the log's own measured gain
+// (never rounded onto the grid); each committed scale band holds the true scale.
+void expect_identified(const AuditResult& r, const Contract& truth) {
+  const Contract& c = r.identified.contract;
+  EXPECT_EQ(c.permutation(), truth.permutation()) << to_text(r);
+  EXPECT_EQ(c.sign(), truth.sign()) << to_text(r);
+  EXPECT_EQ(c.target(), truth.target()) << to_text(r);
+  EXPECT_EQ(c.frame(), truth.frame()) << to_text(r);
+  EXPECT_EQ(c.lag(), truth.lag()) << to_text(r);
+  EXPECT_EQ(c.gripper_inverted(), truth.gripper_inverted()) << to_text(r);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i)
+    if (r.scale_committed[i]) {
+      EXPECT_LE(r.scale_band[i][0], truth.scale()[i]) << i << "\n" << to_text(r);
+      EXPECT_GE(r.scale_band[i][1], truth.scale()[i]) << i << "\n" << to_text(r);
+    }
+}
+
 const AuditField& field(const AuditResult& r, const char* name) {
   const AuditField* f = r.field(name);
   EXPECT_NE(f, nullptr) << name;
@@ -51,8 +69,7 @@ TEST(Audit, IdentityLogPasses) {
   const AuditResult r = run(conv(Contract::identity()), conv(Contract::identity()));
   EXPECT_EQ(r.status, Status::kPass) << to_text(r);
   EXPECT_EQ(r.exit_code(), 0);
-  EXPECT_EQ(r.identified.contract, Contract::identity());
-  EXPECT_GT(r.map_posterior, 0.99);
+  expect_identified(r, Contract::identity());
 }
 
 TEST(Audit, ReferenceContractsAreIdentifiedFieldByField) {
@@ -64,7 +81,7 @@ TEST(Audit, ReferenceContractsAreIdentifiedFieldByField) {
       // against the identity declaration: the MISMATCH names the true contract
       const AuditResult r = run(conv(truth), conv(Contract::identity()), lo);
       ASSERT_EQ(r.status, Status::kMismatch) << to_text(r);
-      EXPECT_EQ(r.identified.contract, truth) << to_text(r);
+      expect_identified(r, truth);
       EXPECT_EQ(r.exit_code(), 1);
       EXPECT_THAT(r.reason, ::testing::AnyOf(HasSubstr("SWAPPED"), HasSubstr("channel routing changed")));
       // against the truth: PASS
@@ -75,13 +92,16 @@ TEST(Audit, ReferenceContractsAreIdentifiedFieldByField) {
 
 TEST(Audit, MismatchIsSaidInWords) {
   const Contract truth = representative_contracts("unseen_composition")[0];  // absolute, tool, gripper inverted
-  const AuditResult r = run(conv(truth), conv(Contract::identity()));
-  ASSERT_EQ(r.status, Status::kMismatch);
+  SyntheticLogOptions lo;
+  lo.episodes = 16;
+  const AuditResult r = run(conv(truth), conv(Contract::identity()), lo);
+  ASSERT_EQ(r.status, Status::kMismatch) << to_text(r);
   EXPECT_THAT(r.reason, HasSubstr("target encoding differs: declared delta, the log is absolute"));
-  EXPECT_THAT(r.reason, HasSubstr("reference frame differs: declared base, the log is tool"));
+  EXPECT_THAT(r.reason, HasSubstr("reference frame differs: declared base, the log is tool")) << to_text(r);
   EXPECT_THAT(r.reason, HasSubstr("gripper polarity differs"));
-  EXPECT_THAT(r.reason, HasSubstr("channels [0, 2, 4] sign FLIPPED"));
-  EXPECT_THAT(r.reason, HasSubstr("channel 0 (x) scale 1.0->0.5 or 0.6 or 0.75 (the log's gain is 0.47x the calibrated one)"));
+  EXPECT_THAT(r.reason, HasSubstr("channels [0, 2, 4] sign FLIPPED")) << to_text(r);
+  // a scale is claimed as the band of the log's gain, never as a grid value
+  EXPECT_THAT(r.reason, HasSubstr("channel 0 (x) scale 1.0 is outside the log's band [")) << to_text(r);
   EXPECT_THAT(to_text(r), HasSubstr("VERDICT: MISMATCH (exit 1)"));
 }
 
@@ -211,19 +231,25 @@ TEST(Audit, NoSingleEpisodeDecidesAField) {
   const AuditField& sign = field(r, "sign");
   EXPECT_FALSE(sign.resolved) << to_text(r);
   EXPECT_THAT(sign.unresolved_channels, ::testing::Contains(3)) << to_text(r);
-  EXPECT_THAT(sign.reason, HasSubstr("one episode decides")) << to_text(r);
+  EXPECT_THAT(sign.reason, HasSubstr("(rx: ")) << to_text(r);
   // four episodes alike: resolved as before
   calm.episodes = 4;
   EXPECT_EQ(audit(synthetic_log(conv(Contract::identity()), model(), calm), o).status, Status::kPass);
 }
 
 TEST(Audit, AnUnmodeledControllerIsNotForcedIntoTheGrammar) {
-  // scale 4 on every channel: outside the grammar's grid {0.5 ... 2}
+  // scale 4 on every channel: outside the grammar's grid {0.5 ... 2}; said so, never a grid scale
   ContractFields f;
   f.scale = {4.0, 4.0, 4.0, 4.0, 4.0, 4.0};
   const AuditResult r = run(conv(Contract::make(f)), conv(Contract::identity()));
-  EXPECT_EQ(r.status, Status::kInconclusive) << to_text(r);
-  EXPECT_THAT(r.reason, HasSubstr("response misspecification"));
+  EXPECT_EQ(r.status, Status::kMismatch) << to_text(r);
+  EXPECT_THAT(r.reason, HasSubstr("no scale of the grammar is in the band"));
+  EXPECT_THAT(field(r, "scale").identified, HasSubstr("(outside the grammar)"));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kPoseDim); ++i)
+    if (r.scale_committed[i]) {
+      EXPECT_LE(r.scale_band[i][0], 4.0);
+      EXPECT_GE(r.scale_band[i][1], 4.0);
+    }
 }
 
 TEST(Audit, AxisAngleLogDeclaredEulerIsThatMismatch) {
@@ -341,6 +367,164 @@ TEST(Audit, ShortLogsAbstainRatherThanGuess) {
   EXPECT_NE(r.status, Status::kPass);
 }
 
+// ---- logs the old model was confidently wrong on (docs/results/audit.md): right or silent
+
+// A closed loop in the base frame under the identity contract: the policy steers x and z to a goal,
+// while the y channel is pushed by a strong persistent disturbance (a contact) that the policy's y
+// command answers, and its rx command moves with its y command (collinear commands). The y motion is
+// mostly the disturbance: its command-response slope runs against the command.
+ActionLog reactive_log(int episodes, int steps, std::uint64_t seed) {
+  const auto m = model();
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  ActionLog log;
+  log.source = "reactive";
+  log.layout = "arrays";
+  for (int e = 0; e < episodes; ++e) {
+    LogEpisode ep;
+    TcpPose pose;
+    pose.position = Vec3(0.4, 0.0, 0.3);
+    const Eigen::Vector4d down(0.0, 1.0, 0.0, 0.0);
+    pose.quaternion = down;
+    Vec3 goal(0.4 + 0.1 * n01(rng), 0.0, 0.2 + 0.05 * n01(rng));
+    double w = 0;
+    for (int t = 0; t <= steps; ++t) {
+      ep.poses.push_back(pose);
+      if (t == steps) break;
+      Action a = Action::Zero();
+      a[0] = std::clamp(8.0 * (goal[0] - pose.position[0]) + 0.3 * n01(rng), -1.0, 1.0);
+      a[2] = std::clamp(8.0 * (goal[2] - pose.position[2]) + 0.3 * n01(rng), -1.0, 1.0);
+      a[1] = std::clamp(-40.0 * pose.position[1] + 0.05 * n01(rng), -1.0, 1.0);  // answers the drift
+      a[3] = 0.7 * a[1] + 0.1 * n01(rng);                                       // moves with y
+      a[4] = 0.3 * n01(rng);
+      a[5] = 0.3 * n01(rng);
+      ep.actions.push_back(a);
+      w = 0.97 * w + 0.02 * n01(rng);  // the disturbance: persistent, much larger than the y response
+      pose.position[0] += m.alpha[0] * a[0] + m.sigma[0] * n01(rng);
+      pose.position[1] += 0.1 * m.alpha[1] * a[1] + w;
+      pose.position[2] += m.alpha[2] * a[2] + m.sigma[2] * n01(rng);
+    }
+    log.episodes.push_back(std::move(ep));
+  }
+  return log;
+}
+
+TEST(AuditHeldOut, AReactiveChannelIsNotReadAsAFlippedSign) {
+  const ActionLog log = reactive_log(40, 50, 3);
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  EXPECT_NE(r.status, Status::kMismatch) << to_text(r);
+  EXPECT_EQ(r.committed_sign[1], 0) << to_text(r);  // y: no sign claimed
+  // uncalibrated too (what a robomimic or LeRobot user has)
+  o.model.reset();
+  const AuditResult u = audit(log, o);
+  EXPECT_NE(u.status, Status::kMismatch) << to_text(u);
+  EXPECT_NE(u.committed_sign[1], -1) << to_text(u);
+}
+
+TEST(AuditHeldOut, ActionsThatExplainNothingAreNoEvidence) {
+  SyntheticLogOptions lo;
+  lo.episodes = 8;
+  ActionLog log = synthetic_log(conv(representative_contracts("seen")[0]), model(), lo);
+  // the action rows shuffled across the log: actions and poses no longer belong together
+  std::vector<Action> all;
+  for (const auto& ep : log.episodes) all.insert(all.end(), ep.actions.begin(), ep.actions.end());
+  std::shuffle(all.begin(), all.end(), std::mt19937_64(5));
+  std::size_t k = 0;
+  for (auto& ep : log.episodes)
+    for (auto& a : ep.actions) a = all[k++];
+  for (bool calibrated : {true, false}) {
+    AuditOptions o;
+    if (calibrated) o.model = model();
+    const AuditResult r = audit(log, o);
+    EXPECT_EQ(r.status, Status::kInconclusive) << to_text(r);
+    EXPECT_THAT(r.reason, HasSubstr("no evidence")) << to_text(r);
+    for (int i = 0; i < kPoseDim; ++i) EXPECT_EQ(r.committed_raw[static_cast<std::size_t>(i)], -1);
+  }
+}
+
+TEST(AuditHeldOut, AFewCorruptedActionCellsDecideNothing) {
+  SyntheticLogOptions lo;
+  lo.episodes = 8;
+  ActionLog log = synthetic_log(conv(Contract::identity()), model(), lo);
+  AuditOptions o;
+  o.model = model();
+  ASSERT_EQ(audit(log, o).status, Status::kPass);
+  log.episodes[1].actions[7][2] = 5.0;
+  log.episodes[4].actions[30][0] = -5.0;
+  log.episodes[6].actions[12][4] = log.episodes[2].actions[40][1];
+  const AuditResult r = audit(log, o);
+  EXPECT_EQ(r.status, Status::kPass) << to_text(r);
+  EXPECT_GE(r.outlier_rows, 2u) << to_text(r);
+}
+
+TEST(AuditHeldOut, ALagOutsideTheGrammarIsNamedSo) {
+  ContractFields f;
+  f.lag = 3;
+  const Contract truth = Contract::make(f);
+  SyntheticLogOptions lo;
+  lo.episodes = 8;
+  const AuditResult r = run(conv(truth), conv(Contract::identity()), lo);
+  ASSERT_TRUE(r.committed_lag.has_value()) << to_text(r);
+  EXPECT_EQ(*r.committed_lag, 3) << to_text(r);
+  EXPECT_EQ(r.status, Status::kMismatch) << to_text(r);
+  EXPECT_THAT(r.reason, HasSubstr("outside the grammar's lags")) << to_text(r);
+  EXPECT_EQ(field(r, "lag").identified, "3 (outside the grammar)");
+  // declared with its own (off-grid) lag: never MISMATCH
+  EXPECT_NE(run(conv(truth), conv(truth), lo).status, Status::kMismatch);
+}
+
+TEST(AuditHeldOut, AScaleOutsideTheGrammarIsNeverAGridValue) {
+  ContractFields f;
+  f.scale = {3.0, 1.0, 1.0, 1.0, 0.3, 1.0};
+  const Contract truth = Contract::make(f);
+  SyntheticLogOptions lo;
+  lo.episodes = 8;
+  const AuditResult r = run(conv(truth), conv(Contract::identity()), lo);
+  EXPECT_NE(r.status, Status::kPass) << to_text(r);
+  for (int i : {0, 4}) {
+    const auto ii = static_cast<std::size_t>(i);
+    if (!r.scale_committed[ii]) continue;
+    EXPECT_LE(r.scale_band[ii][0], truth.scale()[ii]) << to_text(r);
+    EXPECT_GE(r.scale_band[ii][1], truth.scale()[ii]) << to_text(r);
+  }
+  EXPECT_THAT(field(r, "scale").identified, ::testing::Not(HasSubstr("2.0"))) << to_text(r);
+  EXPECT_NE(run(conv(truth), conv(truth), lo).status, Status::kMismatch);
+}
+
+TEST(AuditHeldOut, FingersThatNeverMoveCarryNoPolarity) {
+  auto f = Contract::identity().fields();
+  f.gripper_inverted = true;
+  ActionLog log = synthetic_log(conv(Contract::make(f)), model(), {});
+  for (auto& ep : log.episodes)
+    for (auto& p : ep.poses) p.fingers = Eigen::Vector2d(0.04, 0.04);
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  EXPECT_FALSE(field(r, "gripper_inverted").checked) << to_text(r);
+  EXPECT_FALSE(r.committed_gripper_inverted.has_value());
+  EXPECT_THAT(field(r, "gripper_inverted").reason, HasSubstr("never move"));
+}
+
+TEST(AuditHeldOut, AVerdictNeverCitesAFieldItAlsoCallsUndecided) {
+  // a MISMATCH that commits some channels of a field lists the other channels, not the field, as undecided
+  SyntheticLogOptions lo;
+  lo.episodes = 6;
+  ActionLog log = synthetic_log(conv(representative_contracts("seen")[0]), model(), lo);
+  for (auto& ep : log.episodes)
+    for (auto& a : ep.actions) a[4] = 0.0;  // raw ry never commanded
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  ASSERT_EQ(r.status, Status::kMismatch) << to_text(r);
+  const AuditField& perm = field(r, "permutation");
+  if (!perm.diff.empty() && !perm.resolved) {
+    EXPECT_GT(perm.confidence, 0.0) << to_text(r);
+    EXPECT_THAT(r.reason, HasSubstr("permutation on channel(s)")) << to_text(r);
+  }
+}
+
 // ---- formats
 
 std::string tmp(const std::string& name) {
@@ -369,9 +553,9 @@ TEST(AuditFormats, CsvAndJsonLinesRoundTrip) {
     AuditOptions o;
     o.model = model();
     const AuditResult a = audit(back, o), b = audit(log, o);
-    EXPECT_EQ(a.identified.contract, truth);
+    expect_identified(a, truth);
+    EXPECT_EQ(a.identified.contract, b.identified.contract);
     EXPECT_EQ(to_string(a.status), std::string(to_string(b.status)));
-    EXPECT_DOUBLE_EQ(a.map_posterior, b.map_posterior);
   }
 }
 

@@ -7,10 +7,10 @@
 /// field in words, with its posterior) or INCONCLUSIVE (the log does not excite the fields that would
 /// decide: which ones, and what motion would).
 ///
-/// Identification reuses the grammar belief (adapt::GrammarBelief, the reference implementation's
-/// factorized full-grammar belief): its per-cell evidence is summed over the log's episodes for both
-/// frames, then the exact posterior over (frame, target, lag, permutation) is enumerated (2 × 8 × 720
-/// hypotheses) with sign and scale marginalised per cell. Depends on core and adapt only (no simulator).
+/// Identification fits, for every (target, frame, lag) hypothesis, each output channel's response on
+/// all six raw channels at once, with uncertainty from the log itself (a jackknife and cross-validation
+/// over its episodes); a field is committed only when every hypothesis the log cannot exclude agrees on
+/// it, and lags and scales outside the grammar are named so. Depends on core only (no simulator).
 ///
 /// The extension beyond the paper's grammar (it changes no contract, split or hash): the rotation
 /// representation of the rotation deltas (axis-angle vs two Euler orders), the gripper range ([−1, 1]
@@ -116,6 +116,13 @@ struct AuditOptions {
   /// closed-loop log a policy's small corrections answer disturbances, which biases their apparent
   /// response (measured on the simulator: a sign read backwards at RMS 0.04).
   double min_excitation{0.1};
+  /// A read raw channel must explain at least this share of its output channel's motion variance: in a
+  /// closed loop a channel whose motion is mostly contacts and drift, with the policy's corrections
+  /// answering them, shows a command-response slope of either sign.
+  double min_explained{0.1};
+  /// Rows whose residual under the best hypothesis exceeds this many robust standard deviations (and
+  /// action cells far outside the log's range) are left out: a few corrupted rows decide nothing.
+  double outlier_z{6.0};
 };
 /// One line naming the field and rule, or "" if valid.
 std::string validate(const AuditOptions& o);
@@ -138,9 +145,8 @@ struct AuditResult {
   Status status{Status::kInconclusive};
   std::string reason;
   Conventions declared;
-  Conventions identified;              ///< the MAP (the contract of the grammar that explains the log)
+  Conventions identified;              ///< the best hypothesis (only its resolved fields are claimed)
   std::vector<AuditField> fields;
-  double map_posterior{0.0};           ///< posterior of the MAP contract over the grammar
   double fit_ratio{0.0};               ///< mean squared residual of the MAP / calibrated noise variance
   double noise_inflation{1.0};         ///< the residual-based noise scale the posterior used / calibrated
   bool model_fitted{false};            ///< the response model was fitted from the log
@@ -150,6 +156,17 @@ struct AuditResult {
   /// widened by the gain tolerance and two standard errors (calibrated model only).
   std::array<std::array<double, 2>, kPoseDim> scale_band{};
   std::array<double, kPoseDim> excitation{};      ///< RMS raw command per raw channel
+  // what the verdict commits to (for programs that score audits): -1 / 0 / false / nullopt = not committed
+  std::array<int, kPoseDim> committed_raw{};      ///< raw channel read per output channel
+  std::array<int, kPoseDim> committed_sign{};     ///< ±1 per output channel
+  std::array<bool, kPoseDim> scale_committed{};   ///< the scale_band is a claim (calibrated model only)
+  std::optional<std::string> committed_target, committed_frame;
+  std::optional<int> committed_lag;               ///< may lie outside the grammar's lags (named so)
+  std::optional<bool> committed_gripper_inverted;
+  std::size_t outlier_rows{0};         ///< rows left out of the fits (corrupted cells, outlying responses)
+  double evidence_t{0};                ///< paired t of "the actions explain the motion" against ignoring them
+  double t_critical{0};                ///< the threshold every test of this audit used
+  int plausible_modes{0};              ///< (target, frame, lag) hypotheses the log cannot exclude
   std::size_t episodes{0};
   std::size_t transitions{0};
   std::string source;
