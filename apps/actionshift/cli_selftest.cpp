@@ -76,6 +76,12 @@ void register_selftest_commands(CLI::App& app, CliContext& ctx) {
   audit->add_option("--min-explained", audit_o.audit.min_explained,
                     "Share of an output channel's motion variance its read raw channel must explain to be committed")
       ->capture_default_str();
+  audit->add_option("--max-coupling", audit_o.audit.max_coupling,
+                    "An output channel that a second raw channel moves at more than this fraction of the read channel's\n"
+                    "amplitude is coupled, and its wiring is not committed")->capture_default_str();
+  audit->add_option("--min-margin", audit_o.audit.min_margin,
+                    "A rival hypothesis is excluded only if it predicts the motion worse by at least this log ratio")
+      ->capture_default_str();
   audit->add_option("--outlier-z", audit_o.audit.outlier_z,
                     "Rows whose residual exceeds this many robust standard deviations are left out")->capture_default_str();
   audit->add_option("--misspec-ratio", audit_o.audit.misspec_ratio, "With a calibration: abstain when the best hypothesis fits worse than this x the calibrated noise variance")

@@ -98,6 +98,8 @@ int audit(const AuditCliOptions& o) {
     j["gain_tolerance"] = ao.gain_tolerance;
     j["min_explained"] = ao.min_explained;
     j["outlier_z"] = ao.outlier_z;
+    j["max_coupling"] = ao.max_coupling;
+    j["min_margin"] = ao.min_margin;
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << selftest::to_text(r) << "Declared: " << declared_from << "; response model: " << model_from << "; layout: " << log.layout

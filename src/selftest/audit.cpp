@@ -210,6 +210,10 @@ std::string validate(const AuditOptions& o) {
     return "audit options: min_excitation must be finite and >= 0 (got " + fmt("%g", o.min_excitation) + ")";
   if (!(o.min_explained >= 0.0 && o.min_explained < 1.0))
     return "audit options: min_explained must be in [0, 1) (got " + fmt("%g", o.min_explained) + ")";
+  if (!(o.min_margin >= 0.0) || !std::isfinite(o.min_margin))
+    return "audit options: min_margin must be finite and >= 0 (got " + fmt("%g", o.min_margin) + ")";
+  if (!(o.max_coupling > 0.0 && o.max_coupling <= 1.0))
+    return "audit options: max_coupling must be in (0, 1] (got " + fmt("%g", o.max_coupling) + ")";
   if (!(o.outlier_z > 0.0))
     return "audit options: outlier_z must be > 0 (got " + fmt("%g", o.outlier_z) + ")";
   if (!(o.gain_tolerance >= 1.0) || !std::isfinite(o.gain_tolerance))
@@ -279,7 +283,9 @@ struct Probability {
 // of the MAP's decoded rotation increment (realised angle α·canonical)
 std::array<double, 3> rotation_rep_posterior(const std::vector<std::vector<Step>>& eps, const std::array<double, kPoseDim>& alpha,
                                              const std::array<double, kPoseDim>& sigma, const Contract& c, double* separation,
-                                             std::array<std::array<double, 3>, 3>* sq_residual) {
+                                             std::array<std::array<double, 3>, 3>* sq_residual,
+                                             std::vector<std::array<double, 3>>* unit_sse) {
+  unit_sse->assign(static_cast<std::size_t>(detail::units_of(eps)), std::array<double, 3>{});
   std::array<double, 3> ll{};
   std::array<double, 3> sep{};  // Σ squared standardized distance between the predictions of each pair
   for (const auto& ep : eps)
@@ -298,6 +304,7 @@ std::array<double, 3> rotation_rep_posterior(const std::vector<std::vector<Step>
           const auto ii = static_cast<std::size_t>(i + 3);
           const double e = (y[i] - pred[static_cast<std::size_t>(r)][i]) / (sigma[ii] * std::abs(alpha[ii]));
           ll[static_cast<std::size_t>(r)] -= 0.5 * e * e;
+          (*unit_sse)[static_cast<std::size_t>(ep[t].unit)][static_cast<std::size_t>(r)] += e * e;
           (*sq_residual)[static_cast<std::size_t>(r)][static_cast<std::size_t>(i)] += (y[i] - pred[static_cast<std::size_t>(r)][i]) * (y[i] - pred[static_cast<std::size_t>(r)][i]);
         }
       }
@@ -390,6 +397,8 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     eo.min_excitation = o.min_excitation;
     eo.gain_tolerance = o.gain_tolerance;
     eo.outlier_z = o.outlier_z;
+    eo.min_margin = o.min_margin;
+    eo.max_coupling = o.max_coupling;
     ev = detail::identify(eps, R.excitation, eo);
     const detail::Mode& bm = ev.modes[static_cast<std::size_t>(ev.best)];
     ContractFields f;
@@ -467,52 +476,99 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     } else {
       range_reason = "the gripper commands do not reach both ends of either range";
     }
-    // polarity: fingers after the step against the (lagged, centred) gripper command
-    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-    std::size_t m = 0;
+    // polarity: the fingers after the step against the (lagged) gripper command, the slope's sign with
+    // a jackknife over the log's units (finger positions are slow and serially correlated: a count of
+    // samples overstates the evidence, and on shuffled actions named a polarity at confidence 1). With
+    // the lag not resolved the sign must agree, and pass, at every lag of the grammar.
     const GripperRange r_used = range_conf > 0 ? range : o.declared.gripper_range;
-    for (const auto& ep : eps)
-      for (std::size_t t = 0; t < ep.size(); ++t) {
-        if (!ep[t].finger_next) continue;
-        double g = t >= static_cast<std::size_t>(map_lag) ? ep[t - static_cast<std::size_t>(map_lag)].raw[kGripper] : 0.0;
-        if (r_used == GripperRange::kUnit && t >= static_cast<std::size_t>(map_lag)) g = 2 * g - 1;
-        const double y = *ep[t].finger_next;
-        sx += g;
+    const int U = detail::units_of(eps);
+    struct Sums {
+      double sx{0}, sy{0}, sxx{0}, sxy{0}, syy{0}, m{0};
+      void add(double x, double y) {
+        sx += x;
         sy += y;
-        sxx += g * g;
-        sxy += g * y;
+        sxx += x * x;
+        sxy += x * y;
         syy += y * y;
-        ++m;
+        m += 1;
       }
-    if (m < 3) {
+      void sub(const Sums& o) {
+        sx -= o.sx;
+        sy -= o.sy;
+        sxx -= o.sxx;
+        sxy -= o.sxy;
+        syy -= o.syy;
+        m -= o.m;
+      }
+      double vx() const { return m > 0 ? sxx - sx * sx / m : 0.0; }
+      double vy() const { return m > 0 ? syy - sy * sy / m : 0.0; }
+      double slope() const { return vx() > 0 ? (sxy - sx * sy / m) / vx() : 0.0; }
+    };
+    const auto slope_t = [&](int lag, Sums* total) {
+      std::vector<Sums> unit(static_cast<std::size_t>(U));
+      Sums all;
+      for (const auto& ep : eps)
+        for (std::size_t t = 0; t < ep.size(); ++t) {
+          if (!ep[t].finger_next || t < static_cast<std::size_t>(lag)) continue;
+          double g = ep[t - static_cast<std::size_t>(lag)].raw[kGripper];
+          if (r_used == GripperRange::kUnit) g = 2 * g - 1;
+          unit[static_cast<std::size_t>(ep[t].unit)].add(g, *ep[t].finger_next);
+          all.add(g, *ep[t].finger_next);
+        }
+      *total = all;
+      std::vector<double> loo;
+      for (const auto& u : unit) {
+        if (u.m == 0) continue;
+        Sums rest = all;
+        rest.sub(u);
+        if (rest.vx() <= 0) return 0.0;  // one unit holds every change of the command
+        loo.push_back(rest.slope());
+      }
+      if (loo.size() < 2) return 0.0;
+      double mean = 0, ss = 0;
+      for (double x : loo) mean += x / static_cast<double>(loo.size());
+      for (double x : loo) ss += (x - mean) * (x - mean);
+      const double se = std::sqrt(ss * static_cast<double>(loo.size() - 1) / static_cast<double>(loo.size()));
+      const double b = all.slope();
+      return se > 0 ? b / se : 0.0;
+    };
+    Sums total;
+    slope_t(map_lag, &total);
+    if (total.m < 3) {
       polarity_checked = false;
       polarity_reason = "the log has no finger positions: the gripper's polarity shows only in the fingers";
     } else {
-      const double mn = static_cast<double>(m);
-      const double vx = sxx - sx * sx / mn, cxy = sxy - sx * sy / mn, vy = syy - sy * sy / mn;
-      // finger positions that never move carry no polarity (a zero slope over a zero standard error is
-      // not evidence): the field is then not checked
-      const double finger_sd = std::sqrt(std::max(vy, 0.0) / mn);
-      if (vx <= 1e-12 * mn) {
+      const double finger_sd = std::sqrt(std::max(total.vy(), 0.0) / total.m);
+      if (total.vx() <= 1e-12 * total.m) {
         polarity_reason = "the gripper command never changes; a log that opens and closes the gripper would decide";
       } else if (finger_sd < 1e-5) {
+        // fingers that never move carry no polarity (a zero slope over a zero standard error is no evidence)
         polarity_checked = false;
         polarity_reason = "the finger positions never move in the log (SD " + fmt("%.2g", finger_sd) +
                           " m): they carry no polarity; a log whose fingers follow the gripper would decide";
       } else {
-        const double b = cxy / vx;
-        const double res = std::max(vy - b * cxy, 0.0) / std::max(mn - 2, 1.0);
-        // serial correlation of finger positions: effective samples = the number of command changes
-        std::size_t changes = 1;
-        for (const auto& ep : eps)
-          for (std::size_t t = 1; t < ep.size(); ++t) changes += std::abs(ep[t].raw[kGripper] - ep[t - 1].raw[kGripper]) > 0.1;
-        const double se = std::sqrt(res / vx) * std::sqrt(mn / static_cast<double>(std::min(changes, m)));
-        const double z = se > 0 ? b / se : 0.0;
-        const double p_not = normal_cdf(z);
-        inverted = p_not < 0.5;
-        polarity_conf = se > 0 ? std::max(p_not, 1 - p_not) : 0.0;
+        std::vector<int> lags;
+        if (commands && ev.lag_resolved) lags.push_back(map_lag);
+        else lags.assign(grammar::kLagGrid.begin(), grammar::kLagGrid.end());
+        double weakest = std::numeric_limits<double>::infinity();
+        int sign = 0;
+        bool agree = true;
+        for (int lag : lags) {
+          Sums unused;
+          const double t = slope_t(lag, &unused);
+          const int sg = t > 0 ? 1 : (t < 0 ? -1 : 0);
+          if (sign == 0) sign = sg;
+          agree = agree && sg != 0 && sg == sign;
+          weakest = std::min(weakest, std::abs(t));
+        }
+        const double tc = ev.t_critical > 0 ? ev.t_critical : 3.0;
+        const double zf = floor >= 1.0 ? 40.0 : detail::normal_quantile(floor);
+        inverted = sign < 0;
+        polarity_conf = agree && weakest >= tc ? std::max(floor, normal_cdf(std::min(weakest, 1e6) * zf / tc)) : 0.0;
         if (polarity_conf < floor)
-          polarity_reason = "the fingers follow the gripper command too weakly; more open and close commands would decide";
+          polarity_reason = "the fingers follow the gripper command too weakly or inconsistently over the log's parts (t = " +
+                            fmt("%.2f", agree ? weakest : 0.0) + ", " + fmt("%.2f", tc) +
+                            " needed); more open and close commands would decide";
       }
     }
   } else {
@@ -538,16 +594,30 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     }
   id.gripper_range = range_conf > 0 ? range : o.declared.gripper_range;
   std::array<double, 3> rep_p{1.0 / 3, 1.0 / 3, 1.0 / 3};
-  double rep_separation = 0;
+  double rep_separation = 0, rep_t = 0;
   if (commands) {
     std::array<std::array<double, 3>, 3> sq{};
     // the replay of the rotation channels at the log's own gains (working units of alpha)
     auto rf = map.fields();
     for (int i = 0; i < kPoseDim; ++i) rf.scale[static_cast<std::size_t>(i)] = std::max(ev.map_gain[static_cast<std::size_t>(i)], 1e-9);
-    rep_p = rotation_rep_posterior(eps, alpha, sigma_n, Contract::make(rf), &rep_separation, &sq);
+    std::vector<std::array<double, 3>> unit_sse;
+    rep_p = rotation_rep_posterior(eps, alpha, sigma_n, Contract::make(rf), &rep_separation, &sq, &unit_sse);
     int best = 0;
     for (int r = 1; r < 3; ++r)
       if (rep_p[static_cast<std::size_t>(r)] > rep_p[static_cast<std::size_t>(best)]) best = r;
+    // the representation is told apart only if it predicts better unit by unit (a paired t over the
+    // log's parts, as the hypotheses): the Gaussian likelihood alone ignores serially correlated
+    // residuals, and on the simulator's learned-policy logs named Euler angles at 5,000 transitions
+    rep_t = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < 3; ++r) {
+      if (r == best) continue;
+      std::vector<double> a, b;
+      for (const auto& u : unit_sse) {
+        a.push_back(u[static_cast<std::size_t>(best)]);
+        b.push_back(u[static_cast<std::size_t>(r)]);
+      }
+      rep_t = std::min(rep_t, detail::paired_t(a, b, o.min_margin));
+    }
     id.rotation = static_cast<RotationRep>(best);
     // the misspecification ratio with the rotation channels under the identified representation (the
     // linear fit has the other representations' second-order terms in its residual)
@@ -777,7 +847,8 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
                             "gripper range differs: declared " + std::string(to_string(o.declared.gripper_range)) + ", the logged gripper commands span " +
                                 to_string(id.gripper_range)));
   {
-    const double conf = rep_p[static_cast<std::size_t>(id.rotation)];
+    const double zf = floor >= 1.0 ? 40.0 : detail::normal_quantile(floor);
+    const double conf = rep_t >= ev.t_critical ? std::max(floor, normal_cdf(std::min(rep_t, 1e6) * zf / ev.t_critical)) : 0.0;
     // the representations differ at second order only (half the cross products of the angles): when even
     // a perfect fit could not reach the floor (expected log-odds below log(floor / (1 - floor))), the
     // log cannot tell them apart, and the field is not checked rather than unresolved
@@ -785,12 +856,13 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
     // checked only where the rotation channels' routing and sign are committed (the replay needs them)
     bool rot_committed = true;
     for (int c = 3; c < kPoseDim; ++c) rot_committed = rot_committed && R.committed_sign[static_cast<std::size_t>(c)] != 0;
-    const bool rep_checkable = commands && ev.evidence && rot_committed && rep_separation >= needed;
+    const bool rep_checkable = commands && ev.evidence && rot_committed && rep_separation >= needed && rep_t >= ev.t_critical;
     R.fields.push_back(scalar("rotation", to_string(o.declared.rotation), rep_checkable ? to_string(id.rotation) : to_string(o.declared.rotation),
                               rep_checkable ? conf : 0.0, rep_checkable,
                               commands ? "the log cannot tell the rotation representations apart: they differ only at second order (half the cross products "
                                          "of the angles), and the log's rotations separate them by " + fmt("%.2g", rep_separation) + " (squared noise units; " +
-                                         fmt("%.2g", needed) + " needed); simultaneous rotation commands on two or more axes, well above the noise, would decide"
+                                         fmt("%.2g", needed) + " needed), and over the log's parts the best one predicts better at paired t = " +
+                                         fmt("%.2f", rep_t) + " (" + fmt("%.2f", ev.t_critical) + " needed); simultaneous rotation commands on two or more axes, well above the noise, would decide"
                                        : not_commands,
                               "rotation representation differs: declared " + describe(o.declared.rotation) + ", the log's rotation deltas are " +
                                   describe(id.rotation)));

@@ -75,6 +75,8 @@ struct EvidenceOptions {
   double min_excitation{0.1};   ///< RMS raw command below which a raw channel resolves nothing
   double gain_tolerance{1.8};   ///< calibrated: a gain below grid-min / tolerance is no contract's
   double outlier_z{6.0};        ///< rows whose residual exceeds this many robust SDs are left out
+  double min_margin{0.05};      ///< a rival hypothesis is excluded only if its prediction error is larger by this log ratio
+  double max_coupling{0.5};     ///< a second raw channel may move an output at most this fraction of the read one's amplitude
 };
 
 struct Evidence {
@@ -101,6 +103,10 @@ struct Evidence {
 /// least-squares fit of each output channel on all six raw channels, cross-validated over units; the
 /// fields are those every mode the log cannot exclude agrees on (docs/audit.md, section 2).
 Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excitation, const EvidenceOptions& o);
+
+/// The paired t, over units, of "a predicts better than b by more than `margin`": the mean log ratio of
+/// the units' prediction errors b/a, less the margin, over its standard error.
+double paired_t(const std::vector<double>& a, const std::vector<double>& b, double margin);
 
 /// The one-sided standard normal quantile of p (p in (0, 1)).
 double normal_quantile(double p);

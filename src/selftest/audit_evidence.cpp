@@ -160,7 +160,62 @@ struct Fit {
   std::vector<Pose6> cv;          // per unit: squared prediction error of the other units' fit
   std::vector<Pose6> cv_null;     // the same for "the actions explain nothing" (intercept only)
   Pose6 rss = Pose6::Zero();      // in-sample residual sum of squares per channel
+  // per output channel i and raw channel j: the mean square of the regressor through which raw j
+  // drives channel i, and the mean square of channel i's motion (for the share a raw channel explains)
+  Eigen::Matrix<double, kPoseDim, kPoseDim> sx2 = Eigen::Matrix<double, kPoseDim, kPoseDim>::Zero();
+  Pose6 vy = Pose6::Zero();
 };
+
+bool is_tool_absolute(const Mode& m) { return m.frame == 1 && m.target == Target::kAbsolute; }
+
+const Mat3& rotation_at(const std::vector<Step>& ep, std::size_t t, std::size_t back) { return ep[t >= back ? t - back : 0].R; }
+
+double raw_at(const std::vector<Step>& ep, std::size_t t, std::size_t back, int j) { return t >= back ? ep[t - back].raw[j] : 0.0; }
+
+// A tool-frame absolute target, modelled from the commands rather than from the motion: the
+// controller decodes the target a(t−L) under the rotation R(t−L) and moves by the difference of two
+// decoded targets, R(t−L)·M·a(t−L) − R(t−L−1)·M·a(t−L−1), M the contract's map from raw channels to
+// tool-frame channels (per group: translation, rotation). Linear in M's 3 × 6 entries per group, with
+// one intercept per base component. (Rotating the cumulative motion into the tool frame instead, as
+// the previous model did, assumes the robot reached every target: a closed loop that pushes against
+// the table accumulates targets of 50 normalised units the robot never reaches, and the turn between
+// two steps times that target swamped the log.)
+constexpr int kZ = 3 * kPoseDim + 3;
+using VecZ = Eigen::Matrix<double, kZ, 1>;
+using MatZ = Eigen::Matrix<double, kZ, kZ>;
+
+VecZ z_row(const std::vector<Step>& ep, std::size_t t, const Mode& m, int g, int c) {
+  const auto L = static_cast<std::size_t>(m.lag);
+  const Mat3& R1 = rotation_at(ep, t, L);
+  const Mat3& R0 = rotation_at(ep, t, L + 1);
+  VecZ z = VecZ::Zero();
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < kPoseDim; ++j) z[k * kPoseDim + j] = R1(c, k) * raw_at(ep, t, L, j) - R0(c, k) * raw_at(ep, t, L + 1, j);
+  z[3 * kPoseDim + c] = 1.0;
+  (void)g;
+  return z;
+}
+
+// the prediction of the scaled base-frame response at step t from a coefficient matrix in the
+// audit's layout (beta(j, 3g + k) = M_g(k, j); beta(kPoseDim, 3g + c) the intercept of component c)
+Pose6 predict_tool_absolute(const MatXY& beta, const std::vector<Step>& ep, std::size_t t, const Mode& m) {
+  Pose6 p;
+  for (int g = 0; g < 2; ++g)
+    for (int c = 0; c < 3; ++c) {
+      const VecZ z = z_row(ep, t, m, g, c);
+      double v = beta(kPoseDim, 3 * g + c);
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < kPoseDim; ++j) v += beta(j, 3 * g + k) * z[k * kPoseDim + j];
+      p[3 * g + c] = v;
+    }
+  return p;
+}
+
+Pose6 scaled_response(const std::vector<Step>& ep, std::size_t t, const std::array<double, kPoseDim>& alpha) {
+  Pose6 y;
+  for (int c = 0; c < kPoseDim; ++c) y[c] = ep[t].response[c] / alpha[static_cast<std::size_t>(c)];
+  return y;
+}
 
 struct Masks {
   std::vector<std::vector<char>> bad_raw, bad_response;  // per episode, per step
@@ -180,7 +235,113 @@ RowX regressors(const std::vector<Step>& ep, std::size_t t, const Mode& m) {
   return x;
 }
 
+Fit fit_tool_absolute(const Episodes& eps, const Mode& m, const std::array<double, kPoseDim>& alpha, const Masks& mk, int units) {
+  Fit f;
+  f.mode = m;
+  const auto U = static_cast<std::size_t>(units);
+  struct G {
+    MatZ xx = MatZ::Zero();
+    VecZ xy = VecZ::Zero();
+  };
+  std::vector<std::array<G, 2>> unit(U);
+  std::array<G, 2> all;
+  std::vector<Pose6> sy(U, Pose6::Zero()), yy(U, Pose6::Zero());
+  std::vector<double> n(U, 0.0);
+  for (std::size_t e = 0; e < eps.size(); ++e)
+    for (std::size_t t = 0; t < eps[e].size(); ++t) {
+      if (excluded(mk, e, t, m)) continue;
+      const auto u = static_cast<std::size_t>(eps[e][t].unit);
+      const Pose6 y = scaled_response(eps[e], t, alpha);
+      for (int g = 0; g < 2; ++g)
+        for (int c = 0; c < 3; ++c) {
+          const VecZ z = z_row(eps[e], t, m, g, c);
+          unit[u][static_cast<std::size_t>(g)].xx.noalias() += z * z.transpose();
+          unit[u][static_cast<std::size_t>(g)].xy += z * y[3 * g + c];
+        }
+      sy[u] += y;
+      yy[u] += y.cwiseProduct(y);
+      n[u] += 1;
+    }
+  double N = 0;
+  Pose6 SY = Pose6::Zero(), YY = Pose6::Zero();
+  for (std::size_t u = 0; u < U; ++u) {
+    for (int g = 0; g < 2; ++g) {
+      all[static_cast<std::size_t>(g)].xx += unit[u][static_cast<std::size_t>(g)].xx;
+      all[static_cast<std::size_t>(g)].xy += unit[u][static_cast<std::size_t>(g)].xy;
+    }
+    N += n[u];
+    SY += sy[u];
+    YY += yy[u];
+  }
+  const auto solve_z = [](const MatZ& xx, const VecZ& xy) {
+    MatZ a = xx;
+    a.diagonal().array() += 1e-10 * (a.trace() / kZ) + 1e-300;
+    return VecZ(a.ldlt().solve(xy));
+  };
+  const auto to_beta = [](const std::array<VecZ, 2>& th) {
+    MatXY b = MatXY::Zero();
+    for (int g = 0; g < 2; ++g) {
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < kPoseDim; ++j) b(j, 3 * g + k) = th[static_cast<std::size_t>(g)][k * kPoseDim + j];
+      for (int c = 0; c < 3; ++c) b(kPoseDim, 3 * g + c) = th[static_cast<std::size_t>(g)][3 * kPoseDim + c];
+    }
+    return b;
+  };
+  f.beta = to_beta({solve_z(all[0].xx, all[0].xy), solve_z(all[1].xx, all[1].xy)});
+  for (std::size_t u = 0; u < U; ++u) {
+    if (n[u] == 0 || N - n[u] < kZ) {
+      f.loo.push_back(f.beta);
+      continue;
+    }
+    std::array<VecZ, 2> th;
+    for (int g = 0; g < 2; ++g)
+      th[static_cast<std::size_t>(g)] = solve_z(all[static_cast<std::size_t>(g)].xx - unit[u][static_cast<std::size_t>(g)].xx,
+                                                all[static_cast<std::size_t>(g)].xy - unit[u][static_cast<std::size_t>(g)].xy);
+    f.loo.push_back(to_beta(th));
+  }
+  // residuals: in sample, and each unit's under the fit without it; the regressors' and motion's mean squares
+  f.cv.assign(U, Pose6::Zero());
+  f.cv_null.assign(U, Pose6::Zero());
+  for (std::size_t e = 0; e < eps.size(); ++e)
+    for (std::size_t t = 0; t < eps[e].size(); ++t) {
+      if (excluded(mk, e, t, m)) continue;
+      const auto u = static_cast<std::size_t>(eps[e][t].unit);
+      const Pose6 y = scaled_response(eps[e], t, alpha);
+      const Pose6 r = y - predict_tool_absolute(f.beta, eps[e], t, m);
+      f.rss += r.cwiseProduct(r);
+      const Pose6 rc = y - predict_tool_absolute(f.loo[u], eps[e], t, m);
+      f.cv[u] += rc.cwiseProduct(rc);
+      const Mat3& R1 = rotation_at(eps[e], t, static_cast<std::size_t>(m.lag));
+      for (int g = 0; g < 2; ++g)
+        for (int k = 0; k < 3; ++k) {
+          const Vec3 yg = y.segment<3>(3 * g);
+          f.vy[3 * g + k] += std::pow(R1.col(k).dot(yg), 2);
+          for (int j = 0; j < kPoseDim; ++j) {
+            double ss = 0;
+            for (int c = 0; c < 3; ++c) ss += std::pow(z_row(eps[e], t, m, g, c)[k * kPoseDim + j], 2);
+            f.sx2(3 * g + k, j) += ss;
+          }
+        }
+    }
+  if (N > 0) {
+    f.vy /= N;
+    f.sx2 /= N;
+  }
+  for (std::size_t u = 0; u < U; ++u) {
+    if (n[u] == 0 || N - n[u] < 1) continue;
+    for (int c = 0; c < kPoseDim; ++c) {
+      const double mean = (SY[c] - sy[u][c]) / (N - n[u]);
+      f.cv_null[u][c] = std::max(yy[u][c] - 2.0 * mean * sy[u][c] + n[u] * mean * mean, 0.0);
+    }
+  }
+  f.unit.assign(U, Stats{});
+  for (std::size_t u = 0; u < U; ++u) f.unit[u].n = n[u];
+  f.all.n = N;
+  return f;
+}
+
 Fit fit_mode(const Episodes& eps, const Mode& m, const std::array<double, kPoseDim>& alpha, const Masks& mk, int units) {
+  if (is_tool_absolute(m)) return fit_tool_absolute(eps, m, alpha, mk, units);
   Fit f;
   f.mode = m;
   f.unit.assign(static_cast<std::size_t>(units), Stats{});
@@ -224,7 +385,19 @@ Fit fit_mode(const Episodes& eps, const Mode& m, const std::array<double, kPoseD
     }
     f.cv_null.push_back(nul);
   }
+  const double n = std::max(f.all.n, 1.0);
+  for (int i = 0; i < kPoseDim; ++i) {
+    f.vy[i] = f.all.yy[i] / n - std::pow(f.all.xy(kPoseDim, i) / n, 2);
+    for (int j = 0; j < kPoseDim; ++j) f.sx2(i, j) = f.all.xx(j, j) / n - std::pow(f.all.xx(j, kPoseDim) / n, 2);
+  }
   return f;
+}
+
+// the residual of step t under a fit (scaled response in the mode's working coordinates minus the prediction)
+Pose6 residual(const Fit& f, const MatXY& beta, const std::vector<Step>& ep, std::size_t t, const std::array<double, kPoseDim>& alpha) {
+  const Mode& m = f.mode;
+  if (is_tool_absolute(m)) return scaled_response(ep, t, alpha) - predict_tool_absolute(beta, ep, t, m);
+  return working(ep, t, alpha, m.frame, m.target, m.lag) - beta.transpose() * regressors(ep, t, m);
 }
 
 struct Paired {
@@ -235,7 +408,7 @@ struct Paired {
 // paired t of "a predicts better than b", unit by unit (positive: a better), on the log of the ratio
 // of the two units' prediction errors: scale-free, so a unit that moves ten times more (a harder
 // episode, another part of the workspace) weighs as much as any other instead of deciding alone
-Paired paired(const std::vector<double>& a, const std::vector<double>& b, const std::vector<char>& used) {
+Paired paired(const std::vector<double>& a, const std::vector<double>& b, const std::vector<char>& used, double margin = 0.0) {
   double scale = 0;
   for (std::size_t u = 0; u < a.size(); ++u)
     if (used[u]) scale = std::max({scale, a[u], b[u]});
@@ -252,10 +425,10 @@ Paired paired(const std::vector<double>& a, const std::vector<double>& b, const 
   for (double x : d) ss += (x - mean) * (x - mean);
   const double se = std::sqrt(ss / (k - 1) / k);
   if (se <= 1e-12) {
-    p.t = mean > 1e-9 ? std::numeric_limits<double>::infinity() : 0.0;
+    p.t = mean - margin > 1e-9 ? std::numeric_limits<double>::infinity() : 0.0;
     return p;
   }
-  p.t = mean / se;
+  p.t = (mean - margin) / se;
   return p;
 }
 
@@ -275,6 +448,7 @@ std::string mode_words(const Mode& m) {
 
 const char* kName[kPoseDim] = {"x", "y", "z", "rx", "ry", "rz"};
 
+
 std::string fmt_g(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", x);
@@ -282,6 +456,10 @@ std::string fmt_g(double x) {
 }
 
 }  // namespace
+
+double paired_t(const std::vector<double>& a, const std::vector<double>& b, double margin) {
+  return paired(a, b, std::vector<char>(a.size(), 1), margin).t;
+}
 
 Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excitation, const EvidenceOptions& o) {
   Evidence ev;
@@ -347,8 +525,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
           res[e].push_back(Pose6::Zero());
           continue;
         }
-        const Pose6 r = working(eps[e], t, o.alpha, b.mode.frame, b.mode.target, b.mode.lag) -
-                        b.beta.transpose() * regressors(eps[e], t, b.mode);
+        const Pose6 r = residual(b, b.beta, eps[e], t, o.alpha);
         res[e].push_back(r);
         for (int c = 0; c < kPoseDim; ++c) absr[static_cast<std::size_t>(c)].push_back(std::abs(r[c]));
       }
@@ -411,7 +588,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
       a.push_back(B.cv[u][c]);
       b.push_back(B.cv_null[u][c]);
     }
-    channel_null_t[static_cast<std::size_t>(c)] = paired(a, b, used).t;
+    channel_null_t[static_cast<std::size_t>(c)] = paired(a, b, used, o.min_margin).t;
   }
   ev.null_t = *std::max_element(channel_null_t.begin(), channel_null_t.end());
   ev.evidence = ev.null_t >= tc;
@@ -419,9 +596,26 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
   const Mode& bm = B.mode;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   ev.target_t = ev.frame_t = ev.lag_t = kInf;
+  const auto group_scores = [&](const std::vector<Pose6>& cv, int g) {
+    std::vector<double> out;
+    for (const auto& v : cv) {
+      double x = 0;
+      for (int c = 3 * g; c < 3 * g + 3; ++c) x += v[c];
+      out.push_back(x);
+    }
+    return out;
+  };
+  const std::array<std::vector<double>, 2> best_groups{group_scores(B.cv, 0), group_scores(B.cv, 1)};
   for (std::size_t k = 0; k < fits.size(); ++k) {
     if (static_cast<int>(k) == ev.best) continue;
-    const double t = paired(best_scores, unit_scores(fits[k].cv), used).t;
+    // excluded only if it predicts materially worse (by more than the margin), not merely detectably:
+    // with hundreds of units a misspecified model's tiny systematic difference is "significant"
+    double t = paired(best_scores, unit_scores(fits[k].cv), used, o.min_margin).t;
+    // ... and only if neither group of channels (translation, rotation) says the opposite: where the
+    // translations favour one hypothesis and the rotations the other, one of the two response models is
+    // wrong for this log, and the log does not decide between them
+    for (int g = 0; g < 2; ++g)
+      if (paired(group_scores(fits[k].cv, g), best_groups[static_cast<std::size_t>(g)], used, o.min_margin).t >= tc) t = 0.0;
     ev.plausible[k] = !(t >= tc);
     const Mode& m = ev.modes[k];
     if (m.target != bm.target) ev.target_t = std::min(ev.target_t, t);
@@ -444,7 +638,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
           have = false;
           continue;
         }
-        const Pose6 r = working(eps[e], t, o.alpha, bm.frame, bm.target, bm.lag) - B.beta.transpose() * regressors(eps[e], t, bm);
+        const Pose6 r = residual(B, B.beta, eps[e], t, o.alpha);
         ss += r.cwiseProduct(r);
         if (have) cross += r.cwiseProduct(prev);
         prev = r;
@@ -486,9 +680,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
     c.t = tt[aa];
     c.gain = std::abs(f.beta(arg, i));
     c.se = se[aa];
-    const double n = std::max(f.all.n, 1.0);
-    const double vx = f.all.xx(arg, arg) / n - std::pow(f.all.xx(arg, kPoseDim) / n, 2);
-    const double vy = f.all.yy[i] / n - std::pow(f.all.xy(kPoseDim, i) / n, 2);
+    const double vx = f.sx2(i, arg), vy = f.vy[i];
     c.explained = vy > 0 ? std::min(1.0, c.gain * c.gain * std::max(vx, 0.0) / vy) : 0.0;
     const std::string ch = "raw channel " + std::to_string(arg);
     std::vector<int> idle;
@@ -531,6 +723,25 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
         return c;
       }
     }
+    // the grammar wires one raw channel to an output channel: a second raw channel that moves it at
+    // more than half the first one's amplitude is a coupling (contacts, a closed loop's reactions),
+    // and the wiring is not what the log shows
+    double second = 0;
+    int second_j = -1;
+    for (int j = 0; j < kPoseDim; ++j) {
+      if (j == arg) continue;
+      const double amp = std::abs(f.beta(j, i)) * std::sqrt(std::max(f.sx2(i, j), 0.0));
+      if (amp > second) {
+        second = amp;
+        second_j = j;
+      }
+    }
+    const double first = c.gain * std::sqrt(std::max(f.sx2(i, arg), 0.0));
+    if (second_j >= 0 && second > o.max_coupling * first) {
+      c.why = "raw channel " + std::to_string(second_j) + " moves it at " + fmt_g(second / std::max(first, 1e-300)) + "x the amplitude " + ch +
+              " does: the channels are coupled (contacts, a closed loop's reactions), not wired one to one";
+      return c;
+    }
     c.routed = true;
     return c;
   };
@@ -572,7 +783,17 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
     out.routed = routed;
     out.sign_committed = routed && signed_;
   }
-  // a permutation reads each raw channel once
+  // a permutation reads each raw channel once: a channel whose read raw channel drives another output
+  // channel more strongly (a physical coupling: pulling down turns the tool) is not committed
+  for (int i = 0; i < kPoseDim; ++i)
+    for (int k = 0; k < kPoseDim; ++k) {
+      auto& a = ev.channel[static_cast<std::size_t>(i)];
+      const auto& b = ev.channel[static_cast<std::size_t>(k)];
+      if (i == k || !a.routed || b.raw != a.raw || std::abs(b.t) <= std::abs(a.t)) continue;
+      a.routed = a.sign_committed = false;
+      a.why = "raw channel " + std::to_string(a.raw) + " drives output channel " + kName[k] + " more strongly (a coupling, or " + kName[k] +
+              " reads it)";
+    }
   for (int i = 0; i < kPoseDim; ++i)
     for (int k = i + 1; k < kPoseDim; ++k) {
       auto& a = ev.channel[static_cast<std::size_t>(i)];

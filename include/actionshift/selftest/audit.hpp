@@ -123,6 +123,14 @@ struct AuditOptions {
   /// Rows whose residual under the best hypothesis exceeds this many robust standard deviations (and
   /// action cells far outside the log's range) are left out: a few corrupted rows decide nothing.
   double outlier_z{6.0};
+  /// A rival (target, frame, lag) hypothesis is excluded only if it predicts the log's motion worse by at
+  /// least this log ratio of prediction errors (0.05: 5 %), significantly: a hypothesis that is merely
+  /// detectably worse (a tool frame that hardly turns, a slow response) is not excluded.
+  double min_margin{0.05};
+  /// The grammar wires one raw channel to each output channel: a channel that a second raw channel
+  /// moves at more than this fraction of the read channel's amplitude is coupled (contacts, a closed
+  /// loop's reactions, an arm pulling against the table), and its wiring is not committed.
+  double max_coupling{0.5};
 };
 /// One line naming the field and rule, or "" if valid.
 std::string validate(const AuditOptions& o);
