@@ -93,27 +93,55 @@ Matrix read_matrix(hid_t file, const std::string& source, const std::string& pat
   return m;
 }
 
-std::optional<std::string> read_string_attr(hid_t obj, const char* name) {
+const char* class_name(H5T_class_t c) {
+  switch (c) {
+    case H5T_INTEGER: return "an HDF5 integer";
+    case H5T_FLOAT: return "an HDF5 float";
+    case H5T_COMPOUND: return "an HDF5 compound";
+    case H5T_ENUM: return "an HDF5 enum";
+    case H5T_ARRAY: return "an HDF5 array";
+    case H5T_VLEN: return "an HDF5 variable-length sequence";
+    case H5T_OPAQUE: return "an HDF5 opaque";
+    case H5T_REFERENCE: return "an HDF5 reference";
+    case H5T_BITFIELD: return "an HDF5 bitfield";
+    case H5T_TIME: return "an HDF5 time";
+    default: return "an HDF5 non-string";
+  }
+}
+
+// A text attribute as its writers store it: h5py writes a Python str as a variable-length UTF-8
+// string and numpy bytes (np.bytes_, dtype S) as a fixed-length ASCII string exactly as long as the
+// text (NUL-padded, no terminator); either scalar or a one-element array. The memory type copies the
+// file's (character set, padding), so HDF5 converts nothing: it has no conversion between character
+// sets (a UTF-8 string read as ASCII fails), and a NUL-terminated memory type of the fixed string's
+// size would drop the text's last character.
+// nullopt when absent; anything else is an InputError naming the attribute.
+std::optional<std::string> read_string_attr(hid_t obj, const char* name, const std::string& source, const std::string& where) {
   if (H5Aexists(obj, name) <= 0) return std::nullopt;
   Handle a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
-  if (!a.ok()) return std::nullopt;
+  if (!a.ok()) throw InputError(source, where, "cannot be opened");
   Handle type(H5Aget_type(a.get()), H5Tclose);
-  if (H5Tget_class(type.get()) != H5T_STRING) return std::nullopt;
+  const H5T_class_t cls = H5Tget_class(type.get());
+  if (cls != H5T_STRING) throw InputError(source, where, std::string("not a string (") + class_name(cls) + " attribute)");
+  Handle space(H5Aget_space(a.get()), H5Sclose);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n != 1) throw InputError(source, where, std::to_string(n) + " strings, expected one");
+  Handle mem(H5Tcopy(type.get()), H5Tclose);
+  if (!mem.ok()) throw InputError(source, where, "unreadable string type");
+  std::string out;
   if (H5Tis_variable_str(type.get()) > 0) {
-    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(mem.get(), H5T_VARIABLE);
     char* s = nullptr;
-    if (H5Aread(a.get(), mem.get(), &s) < 0 || !s) return std::nullopt;
-    std::string out(s);
+    if (H5Aread(a.get(), mem.get(), &s) < 0) throw InputError(source, where, "cannot be read as a string");
+    if (s) out = s;
     H5free_memory(s);
-    return out;
+  } else {
+    const std::size_t size = H5Tget_size(type.get());
+    if (size == 0 || size > kMaxJsonDocumentBytes) throw InputError(source, where, "string of " + std::to_string(size) + " bytes");
+    out.assign(size, '\0');
+    if (H5Aread(a.get(), mem.get(), out.data()) < 0) throw InputError(source, where, "cannot be read as a string");
+    out.resize(std::strlen(out.c_str()));  // NUL-padded or NUL-terminated
+    if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD) out.erase(out.find_last_not_of(' ') + 1);
   }
-  const std::size_t n = H5Tget_size(type.get());
-  std::string out(n, '\0');
-  Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(mem.get(), n);
-  if (H5Aread(a.get(), mem.get(), out.data()) < 0) return std::nullopt;
-  out.resize(std::strlen(out.c_str()));
   return out;
 }
 
@@ -235,13 +263,10 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
   log.layout = "robomimic";
   Handle data(H5Gopen2(file, "data", H5P_DEFAULT), H5Gclose);
   if (!data.ok()) throw InputError(path, "data", "not a group");
-  if (auto env = read_string_attr(data.get(), "env_args")) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(*env);
-    } catch (const nlohmann::json::exception&) {
-      throw InputError(path, "data@env_args", "not JSON");
-    }
+  const std::string env_where = "data attribute env_args";
+  if (auto env = read_string_attr(data.get(), "env_args", path, env_where)) {
+    const nlohmann::json j = parse_json_input(*env, path, env_where);
+    if (!j.is_object()) throw InputError(path, env_where, "not a JSON object");
     const auto kw = j.value("env_kwargs", nlohmann::json::object());
     const auto cc = kw.is_object() ? kw.value("controller_configs", nlohmann::json::object()) : nlohmann::json::object();
     if (cc.is_object() && cc.value("type", std::string()) == "OSC_POSE") {
