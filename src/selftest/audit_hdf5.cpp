@@ -257,6 +257,103 @@ ActionLog read_maniskill(hid_t file, const std::string& path, const std::vector<
   return log;
 }
 
+// robosuite's arm controller as robomimic's env_args records it (env_kwargs.controller_configs):
+// before robosuite 1.5 the arm's config itself ({"type": "OSC_POSE", "control_delta": true, ...});
+// from 1.5 a composite controller ({"type": "BASIC", "body_parts": {"right": {"type": "OSC_POSE",
+// "input_type": "delta", "input_ref_frame": "base", ...}, "torso": ...}}), whose arm part is read.
+struct RobosuiteController {
+  std::string type;       // the arm's controller, e.g. OSC_POSE
+  std::string described;  // how declared_from names it
+  std::string absolute;   // non-empty: the key that makes the actions absolute targets
+  std::string bad;        // non-empty: why the config declares nothing (no arm part, unknown frame)
+};
+
+std::optional<RobosuiteController> robosuite_controller(const nlohmann::json& env, const std::string& source, const std::string& where) {
+  const auto member = [&](const nlohmann::json& obj, const char* key, const std::string& at) -> const nlohmann::json* {
+    if (!obj.contains(key) || obj[key].is_null()) return nullptr;
+    if (!obj[key].is_object()) throw InputError(source, where, at + key + ": not a JSON object");
+    return &obj[key];
+  };
+  const nlohmann::json* kw = member(env, "env_kwargs", "");
+  if (!kw) return std::nullopt;
+  if (!kw->contains("controller_configs") || (*kw)["controller_configs"].is_null()) return std::nullopt;
+  RobosuiteController c;
+  const nlohmann::json* cc = &(*kw)["controller_configs"];
+  if (cc->is_array()) {  // one config per robot (robosuite's multi-robot environments)
+    if (cc->size() != 1) {
+      c.described = "robomimic env_args controller_configs";
+      c.bad = std::to_string(cc->size()) + " controllers (one per robot); the audit reads one arm";
+      return c;
+    }
+    cc = &(*cc)[0];
+  }
+  if (!cc->is_object()) throw InputError(source, where, "env_kwargs.controller_configs: not a JSON object");
+  const auto text = [&](const nlohmann::json& obj, const char* key, const std::string& at) -> std::string {
+    if (!obj.contains(key) || obj[key].is_null()) return {};
+    if (!obj[key].is_string()) throw InputError(source, where, at + key + ": not a string");
+    return obj[key].get<std::string>();
+  };
+  const std::string cc_at = "env_kwargs.controller_configs.";
+  const nlohmann::json* arm = cc;
+  std::string arm_at = cc_at;
+  if (const nlohmann::json* parts = member(*cc, "body_parts", cc_at)) {
+    const std::string composite = text(*cc, "type", cc_at);
+    const char* name = parts->contains("right") ? "right" : parts->contains("left") ? "left" : nullptr;
+    c.described = "robomimic env_args controller " + (composite.empty() ? std::string("composite") : composite);
+    if (!name) {
+      c.bad = "body_parts has no arm part (right or left)";
+      return c;
+    }
+    arm_at = cc_at + "body_parts.";
+    arm = member(*parts, name, arm_at);
+    arm_at += std::string(name) + ".";
+    c.described += ", arm part '" + std::string(name) + "':";
+  } else {
+    c.described = "robomimic env_args controller";
+  }
+  c.type = text(*arm, "type", arm_at);
+  c.described += " " + (c.type.empty() ? std::string("(no type)") : c.type);
+  // robosuite >= 1.5 reads input_type; control_delta is what older versions read (and what robomimic's
+  // released configs still write). Either one saying absolute makes the actions absolute targets.
+  const std::string input_type = text(*arm, "input_type", arm_at);
+  if (!input_type.empty() && input_type != "delta" && input_type != "absolute")
+    throw InputError(source, where, arm_at + "input_type: " + quote_input(input_type) + " is neither delta nor absolute");
+  if (input_type == "absolute") c.absolute = "input_type absolute";
+  if (arm->contains("control_delta") && !(*arm)["control_delta"].is_null()) {
+    if (!(*arm)["control_delta"].is_boolean()) throw InputError(source, where, arm_at + "control_delta: not true or false");
+    if (!(*arm)["control_delta"].get<bool>() && c.absolute.empty()) c.absolute = "control_delta false";
+  }
+  const std::string frame = text(*arm, "input_ref_frame", arm_at);
+  if (!frame.empty()) {
+    c.described += ", input_ref_frame " + frame;
+    if (frame != "base" && frame != "world") c.bad = "input_ref_frame " + quote_input(frame) + " is neither base nor world";
+  }
+  return c;
+}
+
+// The declaration a robosuite arm controller makes, given the logged action width: OSC_POSE (7 or 6
+// columns) and OSC_POSITION (4: translation + gripper) with delta input declare robosuite's convention
+// (delta, base, axis-angle, gripper -1 opens). Otherwise nothing is declared and declared_from says why.
+void declare_robosuite(const RobosuiteController& c, int dim, ActionLog* log) {
+  const auto refuse = [&](const std::string& why) { log->declared_from = c.described + ": not declared: " + why + "; pass --declared"; };
+  if (!c.bad.empty()) return refuse(c.bad);
+  if (c.type != "OSC_POSE" && c.type != "OSC_POSITION")
+    return refuse("the audit reads robosuite's end-effector controllers OSC_POSE and OSC_POSITION");
+  if (!c.absolute.empty())
+    return refuse("absolute targets (" + c.absolute +
+                  "): robosuite's is a pose in metres and axis-angle in the base or world frame, which neither the grammar's "
+                  "absolute target (normalised, from the episode's start) nor next_state (the next logged pose) states exactly");
+  const bool fits = c.type == "OSC_POSE" ? (dim == 7 || dim == 6) : dim == 4;
+  if (!fits)
+    return refuse(std::to_string(dim) + "-column actions, but " + c.type + " takes " + (c.type == "OSC_POSE" ? "7 (or 6 without gripper)" : "4"));
+  Conventions conv;
+  auto f = Contract::identity().fields();
+  f.gripper_inverted = true;  // robosuite: -1 opens, +1 closes
+  conv.contract = Contract::make(f);
+  log->declared = conv;
+  log->declared_from = c.described;
+}
+
 ActionLog read_robomimic(hid_t file, const std::string& path) {
   ActionLog log;
   log.source = path;
@@ -264,19 +361,11 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
   Handle data(H5Gopen2(file, "data", H5P_DEFAULT), H5Gclose);
   if (!data.ok()) throw InputError(path, "data", "not a group");
   const std::string env_where = "data attribute env_args";
+  std::optional<RobosuiteController> controller;
   if (auto env = read_string_attr(data.get(), "env_args", path, env_where)) {
     const nlohmann::json j = parse_json_input(*env, path, env_where);
     if (!j.is_object()) throw InputError(path, env_where, "not a JSON object");
-    const auto kw = j.value("env_kwargs", nlohmann::json::object());
-    const auto cc = kw.is_object() ? kw.value("controller_configs", nlohmann::json::object()) : nlohmann::json::object();
-    if (cc.is_object() && cc.value("type", std::string()) == "OSC_POSE") {
-      Conventions c;
-      auto f = Contract::identity().fields();
-      f.gripper_inverted = true;  // robosuite: −1 opens, +1 closes
-      c.contract = Contract::make(f);
-      log.declared = c;
-      log.declared_from = "robomimic env_args controller OSC_POSE";
-    }
+    controller = robosuite_controller(j, path, env_where);
   }
   const auto demos = numbered(data.get(), "demo_");
   if (demos.empty()) throw InputError(path, "data", "no demo_N groups");
@@ -325,6 +414,7 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
     log.episodes.push_back(std::move(ep));
   }
   log.has_gripper = dim != 6;
+  if (controller) declare_robosuite(*controller, dim, &log);
   validate_log(log);
   return log;
 }

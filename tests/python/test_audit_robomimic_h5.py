@@ -149,3 +149,81 @@ def test_env_args_that_is_not_a_json_string_is_a_one_line_error(cli, tmp_path):
     p = write_robomimic(tmp_path / "two.hdf5", demos(1, 5), [json.dumps(env_args({})), "x"])
     assert input_error(cli, p) == f"{p}: {where}: 2 strings, expected one"
 
+
+# ---- 2. robosuite's controllers: before 1.5 the arm's own config, from 1.5 a composite controller
+
+
+def declared_from(cli, path):
+    return audit(cli, path)["declared_from"]
+
+
+def test_composite_controller_declares_from_its_arm_part(cli, tmp_path):
+    log = demos()
+    # robomimic's released 1.5 datasets: control_delta true, input_ref_frame world
+    p = write_robomimic(tmp_path / "world.hdf5", log, json.dumps(env_args(composite(input_ref_frame="world"))))
+    r = audit(cli, p)
+    assert r["declared_from"] == "robomimic env_args controller BASIC, arm part 'right': OSC_POSE, input_ref_frame world"
+    assert r["status"] == "PASS", r["reason"]
+    # robosuite 1.5's own default part config: input_type delta, input_ref_frame base
+    p = write_robomimic(tmp_path / "base.hdf5", log,
+                        json.dumps(env_args(composite(control_delta=None, input_type="delta", input_ref_frame="base"))))
+    r = audit(cli, p)
+    assert r["declared_from"] == "robomimic env_args controller BASIC, arm part 'right': OSC_POSE, input_ref_frame base"
+    assert r["status"] == "PASS", r["reason"]
+    # a robot with its left arm only
+    cc = composite()
+    cc["body_parts"] = {"left": cc["body_parts"]["left"]}
+    p = write_robomimic(tmp_path / "left.hdf5", log, json.dumps(env_args(cc)))
+    assert declared_from(cli, p) == "robomimic env_args controller BASIC, arm part 'left': OSC_POSE"
+    # the flat config before 1.5, also as a one-robot list
+    p = write_robomimic(tmp_path / "flat.hdf5", log, json.dumps(env_args([dict(OSC_PART, type="OSC_POSE")])))
+    assert declared_from(cli, p) == "robomimic env_args controller OSC_POSE"
+
+
+def test_absolute_targets_are_not_declared(cli, tmp_path):
+    log = demos()
+    refused = ("default (identity); robomimic env_args controller BASIC, arm part 'right': OSC_POSE{frame}: not declared: "
+               "absolute targets ({key}): robosuite's is a pose in metres and axis-angle in the base or world frame, which "
+               "neither the grammar's absolute target (normalised, from the episode's start) nor next_state (the next logged "
+               "pose) states exactly; pass --declared")
+    p = write_robomimic(tmp_path / "abs.hdf5", log,
+                        json.dumps(env_args(composite(control_delta=None, input_type="absolute", input_ref_frame="world"))))
+    r = audit(cli, p)
+    assert r["declared_from"] == refused.format(frame=", input_ref_frame world", key="input_type absolute")
+    # identity declared instead: the fingers show robosuite's inverted gripper
+    assert r["status"] == "MISMATCH" and "gripper polarity differs" in r["reason"], r["reason"]
+    p = write_robomimic(tmp_path / "cd.hdf5", log, json.dumps(env_args(composite(control_delta=False))))
+    assert declared_from(cli, p) == refused.format(frame="", key="control_delta false")
+    # the flat config before 1.5
+    p = write_robomimic(tmp_path / "flat.hdf5", log, json.dumps(env_args(dict(OSC_PART, control_delta=False))))
+    assert declared_from(cli, p).startswith(
+        "default (identity); robomimic env_args controller OSC_POSE: not declared: absolute targets (control_delta false)")
+
+
+def test_osc_position_and_other_controllers(cli, tmp_path):
+    # OSC_POSITION: translation + gripper (4 columns), the orientation held
+    log = [(a[:, [0, 1, 2, 6]], p, q, f) for a, p, q, f in demos(rotate=False)]
+    p = write_robomimic(tmp_path / "pos.hdf5", log, json.dumps(env_args(composite(type="OSC_POSITION"))))
+    r = audit(cli, p)
+    assert r["declared_from"] == "robomimic env_args controller BASIC, arm part 'right': OSC_POSITION"
+    assert r["status"] != "MISMATCH", r["reason"]
+    # a width the controller does not take
+    p = write_robomimic(tmp_path / "width.hdf5", log, json.dumps(env_args(composite())))
+    assert declared_from(cli, p) == ("default (identity); robomimic env_args controller BASIC, arm part 'right': OSC_POSE: "
+                                     "not declared: 4-column actions, but OSC_POSE takes 7 (or 6 without gripper); pass --declared")
+    log = demos(2, 20)
+    p = write_robomimic(tmp_path / "joint.hdf5", log, json.dumps(env_args(composite(type="JOINT_VELOCITY"))))
+    assert declared_from(cli, p) == ("default (identity); robomimic env_args controller BASIC, arm part 'right': JOINT_VELOCITY: "
+                                     "not declared: the audit reads robosuite's end-effector controllers OSC_POSE and "
+                                     "OSC_POSITION; pass --declared")
+    p = write_robomimic(tmp_path / "frame.hdf5", log, json.dumps(env_args(composite(input_ref_frame="eef"))))
+    assert declared_from(cli, p).endswith("input_ref_frame eef: not declared: input_ref_frame 'eef' is neither base nor world; "
+                                          "pass --declared")
+    cc = composite()
+    del cc["body_parts"]["right"], cc["body_parts"]["left"]
+    p = write_robomimic(tmp_path / "noarm.hdf5", log, json.dumps(env_args(cc)))
+    assert declared_from(cli, p) == ("default (identity); robomimic env_args controller BASIC: not declared: "
+                                     "body_parts has no arm part (right or left); pass --declared")
+    p = write_robomimic(tmp_path / "type.hdf5", log, json.dumps(env_args(composite(input_type="relative"))))
+    assert input_error(cli, p) == (f"{p}: data attribute env_args: env_kwargs.controller_configs.body_parts.right.input_type: "
+                                   "'relative' is neither delta nor absolute")
