@@ -62,11 +62,38 @@ bool exists(hid_t loc, const std::string& path) {
   }
 }
 
+// a numbered member (demo_N, traj_N) must be a group: its datasets are looked up inside it
+void require_group(hid_t file, const std::string& source, const std::string& path) {
+  Handle g(H5Gopen2(file, path.c_str(), H5P_DEFAULT), H5Gclose);
+  if (!g.ok()) throw InputError(source, path, "not a group");
+}
+
 struct Matrix {
   std::size_t rows{0}, cols{0};
   std::vector<double> v;
   double at(std::size_t r, std::size_t c) const { return v[r * cols + c]; }
 };
+
+// why a dataset may not read: a compression filter this HDF5 library lacks (h5py's own lzf is the
+// usual one: h5py ships it, libhdf5 does not), else ""
+std::string missing_filter(hid_t dataset) {
+  Handle dcpl(H5Dget_create_plist(dataset), H5Pclose);
+  if (!dcpl.ok()) return "";
+  const int n = H5Pget_nfilters(dcpl.get());
+  for (int i = 0; i < n; ++i) {
+    unsigned flags = 0;
+    std::size_t nvalues = 0;
+    char name[64] = {0};
+    unsigned config = 0;
+    const H5Z_filter_t id = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(i), &flags, &nvalues, nullptr, sizeof(name), name, &config);
+    if (id >= 0 && H5Zfilter_avail(id) <= 0) {
+      const std::string label = id == 32000 ? std::string("lzf") : name[0] ? std::string(name) : std::string();
+      return " (compressed with HDF5 filter " + std::to_string(id) + (label.empty() ? "" : " " + quote_input(label)) +
+             ", which this HDF5 library does not have; re-save the file with gzip compression or none)";
+    }
+  }
+  return "";
+}
 
 Matrix read_matrix(hid_t file, const std::string& source, const std::string& path) {
   if (!exists(file, path)) throw InputError(source, path, "missing dataset");
@@ -86,7 +113,7 @@ Matrix read_matrix(hid_t file, const std::string& source, const std::string& pat
   if (m.rows * m.cols > (std::size_t{1} << 28)) throw InputError(source, path, "too large (more than 2^28 numbers)");
   m.v.resize(m.rows * m.cols);
   if (!m.v.empty() && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, m.v.data()) < 0)
-    throw InputError(source, path, "cannot be read as numbers");
+    throw InputError(source, path, "cannot be read as numbers" + missing_filter(d.get()));
   for (std::size_t k = 0; k < m.v.size(); ++k)
     if (!std::isfinite(m.v[k]))
       throw InputError(source, path, "row " + std::to_string(k / m.cols) + " column " + std::to_string(k % m.cols) + ": not a finite number");
@@ -220,6 +247,7 @@ ActionLog read_maniskill(hid_t file, const std::string& path, const std::vector<
   }
   int dim = -1;
   for (const auto& [n, name] : trajs) {
+    require_group(file, path, name);
     const Matrix a = read_matrix(file, path, name + "/actions");
     check_actions(a, path, name + "/actions");
     if (dim < 0) dim = static_cast<int>(a.cols);
@@ -372,6 +400,7 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
   int dim = -1;
   for (const auto& [n, name] : demos) {
     const std::string d = "data/" + name;
+    require_group(file, path, d);
     const Matrix a = read_matrix(file, path, d + "/actions");
     check_actions(a, path, d + "/actions");
     if (dim < 0) dim = static_cast<int>(a.cols);
@@ -385,7 +414,10 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
     std::optional<Matrix> grip;
     if (exists(file, d + "/obs/robot0_gripper_qpos")) {
       grip = read_matrix(file, path, d + "/obs/robot0_gripper_qpos");
-      if (grip->rows != a.rows || grip->cols != 2) throw InputError(path, d + "/obs/robot0_gripper_qpos", "must be T x 2 for T actions");
+      if (grip->rows != a.rows || grip->cols != 2)
+        throw InputError(path, d + "/obs/robot0_gripper_qpos",
+                         std::to_string(grip->rows) + " x " + std::to_string(grip->cols) + ", expected " + std::to_string(a.rows) +
+                             " x 2 (two finger positions, one row per action)");
     }
     const auto pose_at = [&](const Matrix& P, const Matrix& Q, const std::optional<Matrix>& G, std::size_t t, const std::string& where) {
       TcpPose p;

@@ -62,6 +62,15 @@ def test_bad_arrays_are_one_line_errors(tmp_path):
     np.savez(tmp_path / "y.npz", actions=np.zeros((3, 7)))
     with pytest.raises(actionshift.InputError, match=r"y.npz: tcp_pos: missing array"):
         actionshift.audit(str(tmp_path / "y.npz"))
+    # not numbers: one line naming the array, not numpy's ValueError
+    good = record(actionshift.Contract.identity(), episodes=1, steps=5)
+    with pytest.raises(actionshift.InputError, match=r"^arrays: actions: not an array of numbers \(could not convert string"):
+        actionshift.audit(**dict(good, actions=np.full((5, 7), "x")))
+    with pytest.raises(actionshift.InputError, match=r"^arrays: tcp_pos: not an array of numbers \(setting an array element"):
+        actionshift.audit(**dict(good, tcp_pos=[[0.0, 0.0, 0.0], [0.0]] * 2 + [[0.0, 0.0, 0.0]]))
+    np.savez(tmp_path / "obj.npz", **dict(good, fingers=np.array([[0.0, 0.0], None] * 2 + [[0.0, 0.0]], dtype=object)))
+    with pytest.raises(actionshift.InputError, match=r"obj.npz: fingers: cannot be read \(Object arrays cannot be loaded"):
+        actionshift.audit(str(tmp_path / "obj.npz"))
 
 
 def test_without_fingers_the_gripper_polarity_is_not_checked(tmp_path):

@@ -227,3 +227,52 @@ def test_osc_position_and_other_controllers(cli, tmp_path):
     p = write_robomimic(tmp_path / "type.hdf5", log, json.dumps(env_args(composite(input_type="relative"))))
     assert input_error(cli, p) == (f"{p}: data attribute env_args: env_kwargs.controller_configs.body_parts.right.input_type: "
                                    "'relative' is neither delta nor absolute")
+
+
+# ---- 4. plausible files: read, or one line naming the file, the dataset and the reason
+
+
+def test_plausible_files_are_read(cli, tmp_path):
+    ea = json.dumps(env_args({"type": "OSC_POSE"}))
+    # demos of one step among longer ones, with next_obs (one transition each) and without (none)
+    log = demos(6) + demos(2, 1, seed=5)
+    r = audit(cli, write_robomimic(tmp_path / "t1.hdf5", log, ea))
+    assert r["status"] == "PASS" and r["episodes"] == 8 and r["transitions"] == 6 * 50 + 2, (r["reason"], r["transitions"])
+    r = audit(cli, write_robomimic(tmp_path / "t1_no_next.hdf5", log, ea, next_obs=False))
+    assert r["status"] == "PASS" and r["transitions"] == 6 * 49, (r["reason"], r["transitions"])
+    # float32 datasets throughout
+    r = audit(cli, write_robomimic(tmp_path / "f32.hdf5", demos(), ea, dtype=np.float32))
+    assert r["status"] == "PASS", r["reason"]
+    # actions T x 6 (no gripper channel): the gripper fields are not checked
+    r = audit(cli, write_robomimic(tmp_path / "cols6.hdf5", demos(gripper=False), ea))
+    assert r["status"] == "PASS" and not r["fields"]["gripper_inverted"]["checked"], r["reason"]
+    # no robot0_gripper_qpos: the polarity is not checked, the range still is
+    r = audit(cli, write_robomimic(tmp_path / "nogrip.hdf5", demos(), ea, gripper_qpos=False))
+    assert r["status"] == "PASS" and not r["fields"]["gripper_inverted"]["checked"], r["reason"]
+    assert r["fields"]["gripper_range"]["checked"]
+
+
+def test_implausible_files_are_one_line_errors(cli, tmp_path):
+    ea = json.dumps(env_args({"type": "OSC_POSE"}))
+    p = write_robomimic(tmp_path / "empty.hdf5", [], ea)
+    assert input_error(cli, p) == f"{p}: data: no demo_N groups"
+    p = write_robomimic(tmp_path / "t1only.hdf5", demos(2, 1), ea, next_obs=False)
+    assert input_error(cli, p) == f"{p}: no transition (an episode needs two poses and an action between them)"
+    # a demo_N that is not a group
+    p = write_robomimic(tmp_path / "member.hdf5", demos(2, 10), ea)
+    with h5py.File(p, "r+") as f:
+        f["data/demo_7"] = np.zeros(3)
+    assert input_error(cli, p) == f"{p}: data/demo_7: not a group"
+    # a Robotiq gripper's six joints are not two finger positions
+    log = [(a, pos, quat, np.concatenate([fing] * 3, axis=1)) for a, pos, quat, fing in demos(2, 10)]
+    p = write_robomimic(tmp_path / "robotiq.hdf5", log, ea)
+    assert input_error(cli, p) == (f"{p}: data/demo_0/obs/robot0_gripper_qpos: 10 x 6, expected 10 x 2 "
+                                   "(two finger positions, one row per action)")
+    # h5py's own lzf compression: libhdf5 has no such filter
+    p = write_robomimic(tmp_path / "lzf.hdf5", demos(2, 10), ea)
+    with h5py.File(p, "r+") as f:
+        a = f["data/demo_0/actions"][()]
+        del f["data/demo_0/actions"]
+        f["data/demo_0"].create_dataset("actions", data=a, compression="lzf")
+    assert input_error(cli, p) == (f"{p}: data/demo_0/actions: cannot be read as numbers (compressed with HDF5 filter 32000 "
+                                   "'lzf', which this HDF5 library does not have; re-save the file with gzip compression or none)")
