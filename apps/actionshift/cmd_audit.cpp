@@ -57,6 +57,8 @@ int audit(const AuditCliOptions& o) {
   } else if (log.declared) {
     ao.declared = *log.declared;
     declared_from = log.declared_from;
+  } else if (!log.declared_from.empty()) {  // the file names a convention the reader does not declare: why
+    declared_from += "; " + log.declared_from;
   }
   if (!o.rotation.empty()) {
     auto r = selftest::parse_rotation_rep(o.rotation);

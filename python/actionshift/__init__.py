@@ -645,6 +645,12 @@ def _register_gymnasium():
 _register_gymnasium()
 
 
+def _one_line(e, limit=120):
+    """An exception's message as one short line (numpy's can span lines)."""
+    text = " ".join(str(e).split()) or type(e).__name__
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
 def audit(log=None, *, actions=None, tcp_pos=None, tcp_quat=None, fingers=None, episode=None, declared="identity",
           model=None, confidence_floor=0.99, misspec_ratio=25.0, gain_tolerance=1.8):
     """Audit a log: the action contract of recorded data (docs/audit.md). Returns the report as a dict
@@ -672,15 +678,28 @@ def audit(log=None, *, actions=None, tcp_pos=None, tcp_quat=None, fingers=None, 
             missing = [k for k in ("actions", "tcp_pos", "tcp_quat") if k not in z.files]
             if missing:
                 raise InputError(f"{source}: {missing[0]}: missing array")
-            actions, tcp_pos, tcp_quat = z["actions"], z["tcp_pos"], z["tcp_quat"]
-            fingers = z["fingers"] if "fingers" in z.files else None
-            episode = z["episode"] if "episode" in z.files else None
+            arrays = {}
+            for k in ("actions", "tcp_pos", "tcp_quat", "fingers", "episode"):
+                if k in z.files:
+                    try:
+                        arrays[k] = z[k]
+                    except (OSError, ValueError) as e:  # e.g. an object array (pickled): not loaded
+                        raise InputError(f"{source}: {k}: cannot be read ({_one_line(e)})") from None
+            actions, tcp_pos, tcp_quat = arrays["actions"], arrays["tcp_pos"], arrays["tcp_quat"]
+            fingers, episode = arrays.get("fingers"), arrays.get("episode")
     if actions is None or tcp_pos is None or tcp_quat is None:
         raise InputError("audit: actions, tcp_pos and tcp_quat are required")
-    a = _np.asarray(actions, dtype=float)
-    p = _np.asarray(tcp_pos, dtype=float)
-    q = _np.asarray(tcp_quat, dtype=float)
-    f = None if fingers is None else _np.asarray(fingers, dtype=float)
+
+    def numbers(name, x):
+        try:
+            return _np.asarray(x, dtype=float)
+        except (TypeError, ValueError) as e:  # strings, ragged lists
+            raise InputError(f"{source}: {name}: not an array of numbers ({_one_line(e)})") from None
+
+    a = numbers("actions", actions)
+    p = numbers("tcp_pos", tcp_pos)
+    q = numbers("tcp_quat", tcp_quat)
+    f = None if fingers is None else numbers("fingers", fingers)
     for name, arr in (("actions", a), ("tcp_pos", p), ("tcp_quat", q), ("fingers", f)):
         if arr is not None and not _np.all(_np.isfinite(arr)):
             row = int(_np.argwhere(~_np.isfinite(arr))[0][0])

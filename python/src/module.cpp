@@ -1915,10 +1915,12 @@ PYBIND11_MODULE(_native, m) {
           if (!p || p.ndim() != 2 || p.shape(1) != 3) throw InputError(source, where + ": tcp_pos", "must be an N x 3 array");
           if (!q || q.ndim() != 2 || q.shape(1) != 4) throw InputError(source, where + ": tcp_quat", "must be an N x 4 array (w, x, y, z)");
           if (p.shape(0) != q.shape(0)) throw InputError(source, where + ": tcp_quat", "rows differ from tcp_pos's");
-          Arr f;
+          // no fingers: the gripper's polarity is not checked (as for a CSV log without finger columns).
+          // Not a default-constructed array_t: that is an empty 1-D array, which tests true.
+          std::optional<Arr> f;
           if (!t[3].is_none()) {
             f = Arr::ensure(t[3]);
-            if (!f || f.ndim() != 2 || f.shape(1) != 2 || f.shape(0) != p.shape(0)) throw InputError(source, where + ": fingers", "must be an N x 2 array with tcp_pos's rows");
+            if (!*f || f->ndim() != 2 || f->shape(1) != 2 || f->shape(0) != p.shape(0)) throw InputError(source, where + ": fingers", "must be an N x 2 array with tcp_pos's rows");
           }
           selftest::LogEpisode ep;
           for (py::ssize_t r = 0; r < a.shape(0); ++r) {
@@ -1930,7 +1932,7 @@ PYBIND11_MODULE(_native, m) {
             selftest::TcpPose pose;
             pose.position = Vec3(p.at(r, 0), p.at(r, 1), p.at(r, 2));
             pose.quaternion = Eigen::Vector4d(q.at(r, 0), q.at(r, 1), q.at(r, 2), q.at(r, 3));
-            if (f) pose.fingers = Eigen::Vector2d(f.at(r, 0), f.at(r, 1));
+            if (f) pose.fingers = Eigen::Vector2d(f->at(r, 0), f->at(r, 1));
             ep.poses.push_back(pose);
           }
           log.episodes.push_back(std::move(ep));

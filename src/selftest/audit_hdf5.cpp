@@ -62,11 +62,38 @@ bool exists(hid_t loc, const std::string& path) {
   }
 }
 
+// a numbered member (demo_N, traj_N) must be a group: its datasets are looked up inside it
+void require_group(hid_t file, const std::string& source, const std::string& path) {
+  Handle g(H5Gopen2(file, path.c_str(), H5P_DEFAULT), H5Gclose);
+  if (!g.ok()) throw InputError(source, path, "not a group");
+}
+
 struct Matrix {
   std::size_t rows{0}, cols{0};
   std::vector<double> v;
   double at(std::size_t r, std::size_t c) const { return v[r * cols + c]; }
 };
+
+// why a dataset may not read: a compression filter this HDF5 library lacks (h5py's own lzf is the
+// usual one: h5py ships it, libhdf5 does not), else ""
+std::string missing_filter(hid_t dataset) {
+  Handle dcpl(H5Dget_create_plist(dataset), H5Pclose);
+  if (!dcpl.ok()) return "";
+  const int n = H5Pget_nfilters(dcpl.get());
+  for (int i = 0; i < n; ++i) {
+    unsigned flags = 0;
+    std::size_t nvalues = 0;
+    char name[64] = {0};
+    unsigned config = 0;
+    const H5Z_filter_t id = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(i), &flags, &nvalues, nullptr, sizeof(name), name, &config);
+    if (id >= 0 && H5Zfilter_avail(id) <= 0) {
+      const std::string label = id == 32000 ? std::string("lzf") : name[0] ? std::string(name) : std::string();
+      return " (compressed with HDF5 filter " + std::to_string(id) + (label.empty() ? "" : " " + quote_input(label)) +
+             ", which this HDF5 library does not have; re-save the file with gzip compression or none)";
+    }
+  }
+  return "";
+}
 
 Matrix read_matrix(hid_t file, const std::string& source, const std::string& path) {
   if (!exists(file, path)) throw InputError(source, path, "missing dataset");
@@ -86,34 +113,62 @@ Matrix read_matrix(hid_t file, const std::string& source, const std::string& pat
   if (m.rows * m.cols > (std::size_t{1} << 28)) throw InputError(source, path, "too large (more than 2^28 numbers)");
   m.v.resize(m.rows * m.cols);
   if (!m.v.empty() && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, m.v.data()) < 0)
-    throw InputError(source, path, "cannot be read as numbers");
+    throw InputError(source, path, "cannot be read as numbers" + missing_filter(d.get()));
   for (std::size_t k = 0; k < m.v.size(); ++k)
     if (!std::isfinite(m.v[k]))
       throw InputError(source, path, "row " + std::to_string(k / m.cols) + " column " + std::to_string(k % m.cols) + ": not a finite number");
   return m;
 }
 
-std::optional<std::string> read_string_attr(hid_t obj, const char* name) {
+const char* class_name(H5T_class_t c) {
+  switch (c) {
+    case H5T_INTEGER: return "an HDF5 integer";
+    case H5T_FLOAT: return "an HDF5 float";
+    case H5T_COMPOUND: return "an HDF5 compound";
+    case H5T_ENUM: return "an HDF5 enum";
+    case H5T_ARRAY: return "an HDF5 array";
+    case H5T_VLEN: return "an HDF5 variable-length sequence";
+    case H5T_OPAQUE: return "an HDF5 opaque";
+    case H5T_REFERENCE: return "an HDF5 reference";
+    case H5T_BITFIELD: return "an HDF5 bitfield";
+    case H5T_TIME: return "an HDF5 time";
+    default: return "an HDF5 non-string";
+  }
+}
+
+// A text attribute as its writers store it: h5py writes a Python str as a variable-length UTF-8
+// string and numpy bytes (np.bytes_, dtype S) as a fixed-length ASCII string exactly as long as the
+// text (NUL-padded, no terminator); either scalar or a one-element array. The memory type copies the
+// file's (character set, padding), so HDF5 converts nothing: it has no conversion between character
+// sets (a UTF-8 string read as ASCII fails), and a NUL-terminated memory type of the fixed string's
+// size would drop the text's last character.
+// nullopt when absent; anything else is an InputError naming the attribute.
+std::optional<std::string> read_string_attr(hid_t obj, const char* name, const std::string& source, const std::string& where) {
   if (H5Aexists(obj, name) <= 0) return std::nullopt;
   Handle a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
-  if (!a.ok()) return std::nullopt;
+  if (!a.ok()) throw InputError(source, where, "cannot be opened");
   Handle type(H5Aget_type(a.get()), H5Tclose);
-  if (H5Tget_class(type.get()) != H5T_STRING) return std::nullopt;
+  const H5T_class_t cls = H5Tget_class(type.get());
+  if (cls != H5T_STRING) throw InputError(source, where, std::string("not a string (") + class_name(cls) + " attribute)");
+  Handle space(H5Aget_space(a.get()), H5Sclose);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n != 1) throw InputError(source, where, std::to_string(n) + " strings, expected one");
+  Handle mem(H5Tcopy(type.get()), H5Tclose);
+  if (!mem.ok()) throw InputError(source, where, "unreadable string type");
+  std::string out;
   if (H5Tis_variable_str(type.get()) > 0) {
-    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(mem.get(), H5T_VARIABLE);
     char* s = nullptr;
-    if (H5Aread(a.get(), mem.get(), &s) < 0 || !s) return std::nullopt;
-    std::string out(s);
+    if (H5Aread(a.get(), mem.get(), &s) < 0) throw InputError(source, where, "cannot be read as a string");
+    if (s) out = s;
     H5free_memory(s);
-    return out;
+  } else {
+    const std::size_t size = H5Tget_size(type.get());
+    if (size == 0 || size > kMaxJsonDocumentBytes) throw InputError(source, where, "string of " + std::to_string(size) + " bytes");
+    out.assign(size, '\0');
+    if (H5Aread(a.get(), mem.get(), out.data()) < 0) throw InputError(source, where, "cannot be read as a string");
+    out.resize(std::strlen(out.c_str()));  // NUL-padded or NUL-terminated
+    if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD) out.erase(out.find_last_not_of(' ') + 1);
   }
-  const std::size_t n = H5Tget_size(type.get());
-  std::string out(n, '\0');
-  Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(mem.get(), n);
-  if (H5Aread(a.get(), mem.get(), out.data()) < 0) return std::nullopt;
-  out.resize(std::strlen(out.c_str()));
   return out;
 }
 
@@ -192,6 +247,7 @@ ActionLog read_maniskill(hid_t file, const std::string& path, const std::vector<
   }
   int dim = -1;
   for (const auto& [n, name] : trajs) {
+    require_group(file, path, name);
     const Matrix a = read_matrix(file, path, name + "/actions");
     check_actions(a, path, name + "/actions");
     if (dim < 0) dim = static_cast<int>(a.cols);
@@ -229,35 +285,122 @@ ActionLog read_maniskill(hid_t file, const std::string& path, const std::vector<
   return log;
 }
 
+// robosuite's arm controller as robomimic's env_args records it (env_kwargs.controller_configs):
+// before robosuite 1.5 the arm's config itself ({"type": "OSC_POSE", "control_delta": true, ...});
+// from 1.5 a composite controller ({"type": "BASIC", "body_parts": {"right": {"type": "OSC_POSE",
+// "input_type": "delta", "input_ref_frame": "base", ...}, "torso": ...}}), whose arm part is read.
+struct RobosuiteController {
+  std::string type;       // the arm's controller, e.g. OSC_POSE
+  std::string described;  // how declared_from names it
+  std::string absolute;   // non-empty: the key that makes the actions absolute targets
+  std::string bad;        // non-empty: why the config declares nothing (no arm part, unknown frame)
+};
+
+std::optional<RobosuiteController> robosuite_controller(const nlohmann::json& env, const std::string& source, const std::string& where) {
+  const auto member = [&](const nlohmann::json& obj, const char* key, const std::string& at) -> const nlohmann::json* {
+    if (!obj.contains(key) || obj[key].is_null()) return nullptr;
+    if (!obj[key].is_object()) throw InputError(source, where, at + key + ": not a JSON object");
+    return &obj[key];
+  };
+  const nlohmann::json* kw = member(env, "env_kwargs", "");
+  if (!kw) return std::nullopt;
+  if (!kw->contains("controller_configs") || (*kw)["controller_configs"].is_null()) return std::nullopt;
+  RobosuiteController c;
+  const nlohmann::json* cc = &(*kw)["controller_configs"];
+  if (cc->is_array()) {  // one config per robot (robosuite's multi-robot environments)
+    if (cc->size() != 1) {
+      c.described = "robomimic env_args controller_configs";
+      c.bad = std::to_string(cc->size()) + " controllers (one per robot); the audit reads one arm";
+      return c;
+    }
+    cc = &(*cc)[0];
+  }
+  if (!cc->is_object()) throw InputError(source, where, "env_kwargs.controller_configs: not a JSON object");
+  const auto text = [&](const nlohmann::json& obj, const char* key, const std::string& at) -> std::string {
+    if (!obj.contains(key) || obj[key].is_null()) return {};
+    if (!obj[key].is_string()) throw InputError(source, where, at + key + ": not a string");
+    return obj[key].get<std::string>();
+  };
+  const std::string cc_at = "env_kwargs.controller_configs.";
+  const nlohmann::json* arm = cc;
+  std::string arm_at = cc_at;
+  if (const nlohmann::json* parts = member(*cc, "body_parts", cc_at)) {
+    const std::string composite = text(*cc, "type", cc_at);
+    const char* name = parts->contains("right") ? "right" : parts->contains("left") ? "left" : nullptr;
+    c.described = "robomimic env_args controller " + (composite.empty() ? std::string("composite") : composite);
+    if (!name) {
+      c.bad = "body_parts has no arm part (right or left)";
+      return c;
+    }
+    arm_at = cc_at + "body_parts.";
+    arm = member(*parts, name, arm_at);
+    arm_at += std::string(name) + ".";
+    c.described += ", arm part '" + std::string(name) + "':";
+  } else {
+    c.described = "robomimic env_args controller";
+  }
+  c.type = text(*arm, "type", arm_at);
+  c.described += " " + (c.type.empty() ? std::string("(no type)") : c.type);
+  // robosuite >= 1.5 reads input_type; control_delta is what older versions read (and what robomimic's
+  // released configs still write). Either one saying absolute makes the actions absolute targets.
+  const std::string input_type = text(*arm, "input_type", arm_at);
+  if (!input_type.empty() && input_type != "delta" && input_type != "absolute")
+    throw InputError(source, where, arm_at + "input_type: " + quote_input(input_type) + " is neither delta nor absolute");
+  if (input_type == "absolute") c.absolute = "input_type absolute";
+  if (arm->contains("control_delta") && !(*arm)["control_delta"].is_null()) {
+    if (!(*arm)["control_delta"].is_boolean()) throw InputError(source, where, arm_at + "control_delta: not true or false");
+    if (!(*arm)["control_delta"].get<bool>() && c.absolute.empty()) c.absolute = "control_delta false";
+  }
+  const std::string frame = text(*arm, "input_ref_frame", arm_at);
+  if (!frame.empty()) {
+    c.described += ", input_ref_frame " + frame;
+    if (frame != "base" && frame != "world") c.bad = "input_ref_frame " + quote_input(frame) + " is neither base nor world";
+  }
+  return c;
+}
+
+// The declaration a robosuite arm controller makes, given the logged action width: OSC_POSE (7 or 6
+// columns) and OSC_POSITION (4: translation + gripper) with delta input declare robosuite's convention
+// (delta, base, axis-angle, gripper -1 opens). Otherwise nothing is declared and declared_from says why.
+void declare_robosuite(const RobosuiteController& c, int dim, ActionLog* log) {
+  const auto refuse = [&](const std::string& why) { log->declared_from = c.described + ": not declared: " + why + "; pass --declared"; };
+  if (!c.bad.empty()) return refuse(c.bad);
+  if (c.type != "OSC_POSE" && c.type != "OSC_POSITION")
+    return refuse("the audit reads robosuite's end-effector controllers OSC_POSE and OSC_POSITION");
+  if (!c.absolute.empty())
+    return refuse("absolute targets (" + c.absolute +
+                  "): robosuite's is a pose in metres and axis-angle in the base or world frame, which neither the grammar's "
+                  "absolute target (normalised, from the episode's start) nor next_state (the next logged pose) states exactly");
+  const bool fits = c.type == "OSC_POSE" ? (dim == 7 || dim == 6) : dim == 4;
+  if (!fits)
+    return refuse(std::to_string(dim) + "-column actions, but " + c.type + " takes " + (c.type == "OSC_POSE" ? "7 (or 6 without gripper)" : "4"));
+  Conventions conv;
+  auto f = Contract::identity().fields();
+  f.gripper_inverted = true;  // robosuite: -1 opens, +1 closes
+  conv.contract = Contract::make(f);
+  log->declared = conv;
+  log->declared_from = c.described;
+}
+
 ActionLog read_robomimic(hid_t file, const std::string& path) {
   ActionLog log;
   log.source = path;
   log.layout = "robomimic";
   Handle data(H5Gopen2(file, "data", H5P_DEFAULT), H5Gclose);
   if (!data.ok()) throw InputError(path, "data", "not a group");
-  if (auto env = read_string_attr(data.get(), "env_args")) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(*env);
-    } catch (const nlohmann::json::exception&) {
-      throw InputError(path, "data@env_args", "not JSON");
-    }
-    const auto kw = j.value("env_kwargs", nlohmann::json::object());
-    const auto cc = kw.is_object() ? kw.value("controller_configs", nlohmann::json::object()) : nlohmann::json::object();
-    if (cc.is_object() && cc.value("type", std::string()) == "OSC_POSE") {
-      Conventions c;
-      auto f = Contract::identity().fields();
-      f.gripper_inverted = true;  // robosuite: −1 opens, +1 closes
-      c.contract = Contract::make(f);
-      log.declared = c;
-      log.declared_from = "robomimic env_args controller OSC_POSE";
-    }
+  const std::string env_where = "data attribute env_args";
+  std::optional<RobosuiteController> controller;
+  if (auto env = read_string_attr(data.get(), "env_args", path, env_where)) {
+    const nlohmann::json j = parse_json_input(*env, path, env_where);
+    if (!j.is_object()) throw InputError(path, env_where, "not a JSON object");
+    controller = robosuite_controller(j, path, env_where);
   }
   const auto demos = numbered(data.get(), "demo_");
   if (demos.empty()) throw InputError(path, "data", "no demo_N groups");
   int dim = -1;
   for (const auto& [n, name] : demos) {
     const std::string d = "data/" + name;
+    require_group(file, path, d);
     const Matrix a = read_matrix(file, path, d + "/actions");
     check_actions(a, path, d + "/actions");
     if (dim < 0) dim = static_cast<int>(a.cols);
@@ -271,7 +414,10 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
     std::optional<Matrix> grip;
     if (exists(file, d + "/obs/robot0_gripper_qpos")) {
       grip = read_matrix(file, path, d + "/obs/robot0_gripper_qpos");
-      if (grip->rows != a.rows || grip->cols != 2) throw InputError(path, d + "/obs/robot0_gripper_qpos", "must be T x 2 for T actions");
+      if (grip->rows != a.rows || grip->cols != 2)
+        throw InputError(path, d + "/obs/robot0_gripper_qpos",
+                         std::to_string(grip->rows) + " x " + std::to_string(grip->cols) + ", expected " + std::to_string(a.rows) +
+                             " x 2 (two finger positions, one row per action)");
     }
     const auto pose_at = [&](const Matrix& P, const Matrix& Q, const std::optional<Matrix>& G, std::size_t t, const std::string& where) {
       TcpPose p;
@@ -300,6 +446,7 @@ ActionLog read_robomimic(hid_t file, const std::string& path) {
     log.episodes.push_back(std::move(ep));
   }
   log.has_gripper = dim != 6;
+  if (controller) declare_robosuite(*controller, dim, &log);
   validate_log(log);
   return log;
 }

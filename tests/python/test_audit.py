@@ -62,3 +62,29 @@ def test_bad_arrays_are_one_line_errors(tmp_path):
     np.savez(tmp_path / "y.npz", actions=np.zeros((3, 7)))
     with pytest.raises(actionshift.InputError, match=r"y.npz: tcp_pos: missing array"):
         actionshift.audit(str(tmp_path / "y.npz"))
+    # not numbers: one line naming the array, not numpy's ValueError
+    good = record(actionshift.Contract.identity(), episodes=1, steps=5)
+    with pytest.raises(actionshift.InputError, match=r"^arrays: actions: not an array of numbers \(could not convert string"):
+        actionshift.audit(**dict(good, actions=np.full((5, 7), "x")))
+    with pytest.raises(actionshift.InputError, match=r"^arrays: tcp_pos: not an array of numbers \(setting an array element"):
+        actionshift.audit(**dict(good, tcp_pos=[[0.0, 0.0, 0.0], [0.0]] * 2 + [[0.0, 0.0, 0.0]]))
+    np.savez(tmp_path / "obj.npz", **dict(good, fingers=np.array([[0.0, 0.0], None] * 2 + [[0.0, 0.0]], dtype=object)))
+    with pytest.raises(actionshift.InputError, match=r"obj.npz: fingers: cannot be read \(Object arrays cannot be loaded"):
+        actionshift.audit(str(tmp_path / "obj.npz"))
+
+
+def test_without_fingers_the_gripper_polarity_is_not_checked(tmp_path):
+    # as the CLI does for a log without finger positions (a CSV without finger_0/finger_1)
+    log = record(actionshift.Contract.identity(), episodes=4)
+    del log["fingers"]
+    r = actionshift.audit(**log, declared="identity", model=TASK)
+    g = r["fields"]["gripper_inverted"]
+    assert not g["checked"] and "no finger positions" in g["reason"], g
+    assert r["status"] in ("PASS", "INCONCLUSIVE"), r["reason"]
+    # the same .npz without a fingers array, with and without episode ids
+    np.savez(tmp_path / "nofingers.npz", **log)
+    r2 = actionshift.audit(str(tmp_path / "nofingers.npz"), declared="identity", model=TASK)
+    assert r2["reason"] == r["reason"] and not r2["fields"]["gripper_inverted"]["checked"]
+    one = {k: v[log["episode"] == 0] for k, v in log.items() if k != "episode"}
+    r3 = actionshift.audit(**one, declared="identity", model=TASK)
+    assert not r3["fields"]["gripper_inverted"]["checked"], r3["fields"]["gripper_inverted"]

@@ -19,7 +19,10 @@ namespace actionshift::selftest {
 /// - robomimic: `data/demo_N/actions` (T × 7), `data/demo_N/obs/robot0_eef_pos` (T × 3),
 ///   `robot0_eef_quat` (T × 4, x y z w), `robot0_gripper_qpos` (T × 2; the second finger's sign is
 ///   flipped, so both open positive), `next_obs/…` (optional: the final pose); `data` attribute
-///   `env_args` (JSON): an OSC_POSE controller declares delta, base, axis-angle, gripper −1 open.
+///   `env_args` (JSON, a variable-length or fixed-length string): robosuite's OSC_POSE or OSC_POSITION
+///   arm controller with delta input (the config itself before robosuite 1.5, a composite
+///   controller's arm part from 1.5) declares delta, base, axis-angle, gripper −1 open; absolute
+///   input and other controllers declare nothing, and `declared_from` says why.
 /// Throws InputError(path, "<dataset path>", reason) for anything else.
 ActionLog read_log_hdf5(const std::string& path);
 
