@@ -198,17 +198,30 @@ VecZ z_row(const std::vector<Step>& ep, std::size_t t, const Mode& m, int g, int
 
 // the prediction of the scaled base-frame response at step t from a coefficient matrix in the
 // audit's layout (beta(j, 3g + k) = M_g(k, j); beta(kPoseDim, 3g + c) the intercept of component c)
-Pose6 predict_tool_absolute(const MatXY& beta, const std::vector<Step>& ep, std::size_t t, const Mode& m) {
+using ZRows = std::array<std::array<VecZ, 3>, 2>;  // [group][component]
+
+ZRows z_rows(const std::vector<Step>& ep, std::size_t t, const Mode& m) {
+  ZRows z;
+  for (int g = 0; g < 2; ++g)
+    for (int c = 0; c < 3; ++c) z[static_cast<std::size_t>(g)][static_cast<std::size_t>(c)] = z_row(ep, t, m, g, c);
+  return z;
+}
+
+Pose6 predict_tool_absolute(const MatXY& beta, const ZRows& z) {
   Pose6 p;
   for (int g = 0; g < 2; ++g)
     for (int c = 0; c < 3; ++c) {
-      const VecZ z = z_row(ep, t, m, g, c);
+      const VecZ& zc = z[static_cast<std::size_t>(g)][static_cast<std::size_t>(c)];
       double v = beta(kPoseDim, 3 * g + c);
       for (int k = 0; k < 3; ++k)
-        for (int j = 0; j < kPoseDim; ++j) v += beta(j, 3 * g + k) * z[k * kPoseDim + j];
+        for (int j = 0; j < kPoseDim; ++j) v += beta(j, 3 * g + k) * zc[k * kPoseDim + j];
       p[3 * g + c] = v;
     }
   return p;
+}
+
+Pose6 predict_tool_absolute(const MatXY& beta, const std::vector<Step>& ep, std::size_t t, const Mode& m) {
+  return predict_tool_absolute(beta, z_rows(ep, t, m));
 }
 
 Pose6 scaled_response(const std::vector<Step>& ep, std::size_t t, const std::array<double, kPoseDim>& alpha) {
@@ -252,9 +265,10 @@ Fit fit_tool_absolute(const Episodes& eps, const Mode& m, const std::array<doubl
       if (excluded(mk, e, t, m)) continue;
       const auto u = static_cast<std::size_t>(eps[e][t].unit);
       const Pose6 y = scaled_response(eps[e], t, alpha);
+      const ZRows zr = z_rows(eps[e], t, m);
       for (int g = 0; g < 2; ++g)
         for (int c = 0; c < 3; ++c) {
-          const VecZ z = z_row(eps[e], t, m, g, c);
+          const VecZ& z = zr[static_cast<std::size_t>(g)][static_cast<std::size_t>(c)];
           unit[u][static_cast<std::size_t>(g)].xx.noalias() += z * z.transpose();
           unit[u][static_cast<std::size_t>(g)].xy += z * y[3 * g + c];
         }
@@ -307,9 +321,10 @@ Fit fit_tool_absolute(const Episodes& eps, const Mode& m, const std::array<doubl
       if (excluded(mk, e, t, m)) continue;
       const auto u = static_cast<std::size_t>(eps[e][t].unit);
       const Pose6 y = scaled_response(eps[e], t, alpha);
-      const Pose6 r = y - predict_tool_absolute(f.beta, eps[e], t, m);
+      const ZRows zr = z_rows(eps[e], t, m);
+      const Pose6 r = y - predict_tool_absolute(f.beta, zr);
       f.rss += r.cwiseProduct(r);
-      const Pose6 rc = y - predict_tool_absolute(f.loo[u], eps[e], t, m);
+      const Pose6 rc = y - predict_tool_absolute(f.loo[u], zr);
       f.cv[u] += rc.cwiseProduct(rc);
       const Mat3& R1 = rotation_at(eps[e], t, static_cast<std::size_t>(m.lag));
       for (int g = 0; g < 2; ++g)
@@ -318,7 +333,7 @@ Fit fit_tool_absolute(const Episodes& eps, const Mode& m, const std::array<doubl
           f.vy[3 * g + k] += std::pow(R1.col(k).dot(yg), 2);
           for (int j = 0; j < kPoseDim; ++j) {
             double ss = 0;
-            for (int c = 0; c < 3; ++c) ss += std::pow(z_row(eps[e], t, m, g, c)[k * kPoseDim + j], 2);
+            for (int c = 0; c < 3; ++c) ss += std::pow(zr[static_cast<std::size_t>(g)][static_cast<std::size_t>(c)][k * kPoseDim + j], 2);
             f.sx2(3 * g + k, j) += ss;
           }
         }
