@@ -104,8 +104,8 @@ struct Evidence {
 /// fields are those every mode the log cannot exclude agrees on (docs/audit.md, section 2).
 Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excitation, const EvidenceOptions& o);
 
-/// The paired t, over units, of "a predicts better than b by more than `margin`": the mean log ratio of
-/// the units' prediction errors b/a, less the margin, over its standard error.
+/// The t, over units, of "a predicts better than b by more than `margin`": the log ratio of the pooled
+/// prediction errors Σb/Σa, less the margin, over its jackknife standard error.
 double paired_t(const std::vector<double>& a, const std::vector<double>& b, double margin);
 
 /// The one-sided standard normal quantile of p (p in (0, 1)).

@@ -234,8 +234,12 @@ struct Masks {
   std::vector<std::vector<char>> bad_raw, bad_response;  // per episode, per step
 };
 
+// Every hypothesis is fitted on the same rows: those whose every searched lag reaches back inside the
+// episode. (Padding the commands before an episode's start with zeros makes each raw channel an
+// indicator of "not the first L steps", which alone explains how a policy's first steps differ from
+// the rest: on a log whose actions were shuffled across rows it "explained" z at t = 5.5.)
 bool excluded(const Masks& mk, std::size_t e, std::size_t t, const Mode& m) {
-  if (mk.bad_response[e][t]) return true;
+  if (t < static_cast<std::size_t>(kSearchLag) + 1 || mk.bad_response[e][t]) return true;
   const auto L = static_cast<std::size_t>(m.lag);
   if (t >= L && mk.bad_raw[e][t - L]) return true;
   return m.target == Target::kAbsolute && t >= L + 1 && mk.bad_raw[e][t - L - 1];
@@ -420,30 +424,38 @@ struct Paired {
   int n{0};
 };
 
-// paired t of "a predicts better than b", unit by unit (positive: a better), on the log of the ratio
-// of the two units' prediction errors: scale-free, so a unit that moves ten times more (a harder
-// episode, another part of the workspace) weighs as much as any other instead of deciding alone
+// paired t of "a predicts better than b by more than `margin`", over units: the log of the ratio of
+// the pooled prediction errors, log(Σb / Σa), less the margin, over its jackknife standard error
+// (each unit left out in turn). Pooled, so that units in which the robot holds still (a scripted
+// policy's grasp) do not dilute the comparison; jackknifed, so that a unit that carries the whole
+// difference (one episode's contact) leaves it undecided.
 Paired paired(const std::vector<double>& a, const std::vector<double>& b, const std::vector<char>& used, double margin = 0.0) {
-  double scale = 0;
+  double sa = 0, sb = 0;
+  int k = 0;
   for (std::size_t u = 0; u < a.size(); ++u)
-    if (used[u]) scale = std::max({scale, a[u], b[u]});
-  const double eps = 1e-12 * scale + 1e-300;
-  std::vector<double> d;
-  for (std::size_t u = 0; u < a.size(); ++u)
-    if (used[u]) d.push_back(std::log((b[u] + eps) / (a[u] + eps)));
+    if (used[u]) {
+      sa += a[u];
+      sb += b[u];
+      ++k;
+    }
   Paired p;
-  p.n = static_cast<int>(d.size());
-  if (d.size() < 2) return p;
-  const double k = static_cast<double>(d.size());
-  const double mean = std::accumulate(d.begin(), d.end(), 0.0) / k;
-  double ss = 0;
-  for (double x : d) ss += (x - mean) * (x - mean);
-  const double se = std::sqrt(ss / (k - 1) / k);
+  p.n = k;
+  if (k < 2) return p;
+  const double eps = 1e-12 * std::max(sa, sb) + 1e-300;
+  const double r = std::log((sb + eps) / (sa + eps));
+  std::vector<double> loo;
+  for (std::size_t u = 0; u < a.size(); ++u)
+    if (used[u]) loo.push_back(std::log((sb - b[u] + eps) / (sa - a[u] + eps)));
+  const double kk = static_cast<double>(loo.size());
+  double mean = 0, ss = 0;
+  for (double x : loo) mean += x / kk;
+  for (double x : loo) ss += (x - mean) * (x - mean);
+  const double se = std::sqrt(ss * (kk - 1) / kk);
   if (se <= 1e-12) {
-    p.t = mean - margin > 1e-9 ? std::numeric_limits<double>::infinity() : 0.0;
+    p.t = r - margin > 1e-9 ? std::numeric_limits<double>::infinity() : 0.0;
     return p;
   }
-  p.t = (mean - margin) / se;
+  p.t = (r - margin) / se;
   return p;
 }
 
