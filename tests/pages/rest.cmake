@@ -49,3 +49,8 @@ if(TARGET actionshift AND ACTIONSHIFT_BUILD_BENCHMARKS)
                    ${CMAKE_CURRENT_BINARY_DIR}/brittleness_dp_script)
   set_tests_properties(pages.brittleness_dp_script PROPERTIES LABELS pages TIMEOUT 600)
 endif()
+if(Python3_Interpreter_FOUND)
+  # the audit benchmark's scoring: which committed claims are wrong (new and previous model's JSON), one case per rule
+  add_test(NAME pages.audit_scoring COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/pages/audit_scoring_test.py)
+  set_tests_properties(pages.audit_scoring PROPERTIES LABELS "pages;audit" TIMEOUT 60)
+endif()

@@ -82,18 +82,19 @@ def page_text(page, binary, tmp):
         return py("scripts/ladder_report.py", f"{d}/results", cdir, *PROV, "--command", f"scripts/ladder {d}/results",
                   "--learned", f"{tmp}/learned.json", "--learned-command", f"scripts/backbone_variance {b}/results")
     if page == "audit":
-        # real audit outputs (tests/pages/data/audit/: a few of the benchmark's, and one wrong verdict of the
-        # audit's first model so the wrong-verdicts table is laid out); the intervals need the build's module
+        # real audit outputs of the fixture logs (tests/selftest/data/audit_bench: five 200-transition logs of the
+        # tuning set) at 50 and 200 transitions, by the audit (two tuning configurations, one evaluation) and by the
+        # previous model (tests/pages/data/audit/README.md); the intervals need the build's module
         build = os.path.dirname(os.path.dirname(os.path.dirname(binary)))
         env = dict(os.environ, PYTHONPATH=os.path.join(build, "python"))
-        chosen = subprocess.run([sys.executable, "scripts/audit_report.py", "--choose", f"{d}/pilot"], check=True, cwd=ROOT,
-                                capture_output=True, text=True, env=env).stdout.split()
+        chosen = subprocess.run([sys.executable, "scripts/audit_report.py", "--choose", f"{d}/tuning"], check=True, cwd=ROOT,
+                                capture_output=True, text=True, env=env).stdout.strip()
         out = f"{tmp}/audit.md"
-        subprocess.run([sys.executable, "scripts/audit_report.py", "--out", out, "--svg", f"{tmp}/audit.svg", "--pilot", f"{d}/pilot",
-                        "--evaluation", f"{d}/evaluation", "--floor", chosen[0], "--tolerance", chosen[1], "--tolerances", "1.8 2.2",
+        subprocess.run([sys.executable, "scripts/audit_report.py", "--out", out, "--svg", f"{tmp}/audit.svg", "--tuning", f"{d}/tuning",
+                        "--chosen", chosen, "--evaluation", f"{d}/evaluation", "--old", f"{d}/previous", "--old-commit", "d9c0511",
                         "--command", f"scripts/audit_benchmark {d}", "--commit", "0000000", "--wall", "12",
-                        "--pilot-seeds", "20260801", "--eval-seeds", "20260811 20260812", "--lengths", "50 200 5000",
-                        "--noises", "0 0.005", "--floors", "0.99"], check=True, cwd=ROOT, env=env, capture_output=True)
+                        "--tuning-seeds", "20260901 20260902", "--eval-seeds", "20260911 20260912", "--lengths", "50 200",
+                        "--eval-committed", "37eea8d"], check=True, cwd=ROOT, env=env, capture_output=True)
         return open(out).read() + "\n<!-- svg -->\n" + open(f"{tmp}/audit.svg").read()
     raise SystemExit(f"run_page_test: unknown page {page}")
 
