@@ -299,6 +299,9 @@ def main():
     ap.add_argument("--eval-seeds", default="")
     ap.add_argument("--eval-committed", default="", help="the commit that froze the evaluation set's cases")
     ap.add_argument("--lengths", default="50 200 1000 5000")
+    ap.add_argument("--spent", help="the first evaluation set's audits with the chosen configuration (no longer held out)")
+    ap.add_argument("--spent-seeds", default="")
+    ap.add_argument("--first-round", help="the first benchmarked model's audits of the first evaluation set")
     a = ap.parse_args()
     if a.choose:
         print(choose(a.choose))
@@ -347,8 +350,9 @@ def main():
                  "declared = its recorded contract, and declared = identity. The cases, contracts and SHA-256 of every log are "
                  "committed in `configs/audit/`" + (f"; the evaluation set's in commit `{a.eval_committed[:12]}`, before "
                  "anything was tuned" if a.eval_committed else "") + ".\n")
-    lines.append(f"**Seeds.** Tuning: {a.tuning_seeds} (role pilot). Evaluation: {a.eval_seeds} (role evaluation). Both registered "
-                 "in `configs/seeds.yaml` and checked disjoint by `tests/eval/seed_registry_test.cpp`.\n")
+    lines.append(f"**Seeds.** Tuning: {a.tuning_seeds} (role pilot). Evaluation: {a.eval_seeds} (role evaluation)"
+                 + (f"; the first evaluation set, no longer held out: {a.spent_seeds}" if a.spent_seeds else "")
+                 + ". All registered in `configs/seeds.yaml` and checked disjoint by `tests/eval/seed_registry_test.cpp`.\n")
     lines.append(f"**Thresholds.** Chosen on the tuning set only: **{a.chosen}** (the configuration with no wrong committed tuning "
                  "verdict and the highest tuning coverage, or, when none is clean, the fewest wrong; ties go to the most cautious: "
                  "higher floor, higher minimum explained share, wider gain tolerance, smaller coupling). The evaluation set is "
@@ -373,6 +377,19 @@ def main():
         lines.append("The previous model on the tuning set:\n")
         lines.append(table.markdown(["transitions", "audits", "coverage", "wrong / committed", "upper bound", "-", "-", "-"],
                                     length_rows(old_tun, [], lengths)))
+        lines.append("")
+    if a.spent:
+        spent = load(a.spent)
+        first = load(a.first_round) if a.first_round else []
+        lines.append("## The first evaluation set, no longer held out\n")
+        lines.append("The first frozen evaluation set (configs/audit/evaluation.cases.jsonl) was audited once with the first "
+                     "benchmarked model (commit `ee4580d`); its wrong verdicts there (the gripper's range and polarity on MLP "
+                     "logs, a coupled routing under contact) shaped the current model, so that set no longer tests it. The held-out "
+                     "numbers above are the second frozen evaluation set's, recorded and committed before the current model was "
+                     "tuned. Both models on the first set:\n")
+        lines.append(table.markdown(["transitions", "audits", "current: coverage", "current: wrong / committed", "upper bound",
+                                     "first model: coverage", "first model: wrong / committed", "first model: upper bound"],
+                                    length_rows(spent, first, lengths)))
         lines.append("")
     lines.append("## By backbone, family, calibration and variant (evaluation set)\n")
     lines.append(table.markdown(["backbone", "transitions", "audits", "coverage", "wrong / committed", "upper bound"],

@@ -326,6 +326,10 @@ std::array<double, 3> rotation_rep_posterior(const std::vector<std::vector<Step>
 
 double normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 
+// the share of the finger positions' variance the gripper command must explain for a polarity to be
+// read from them (a design constant, fixed before the second evaluation set was recorded)
+constexpr double kMinFingerR2 = 0.5;
+
 }  // namespace
 
 AuditResult audit(const ActionLog& log, const AuditOptions& o) {
@@ -448,6 +452,7 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   // 4. the gripper: range from the numbers, polarity from the fingers (the best mode's lag)
   GripperRange range = o.declared.gripper_range;
   double range_conf = 0;
+  bool range_checked = log.has_gripper;
   std::string range_reason;
   bool inverted = o.declared.contract.gripper_inverted();
   double polarity_conf = 0;
@@ -456,7 +461,7 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
   const int map_lag = commands ? map.lag() : 0;
   if (log.has_gripper) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    std::size_t n_lo = 0, n_hi = 0;
+    std::size_t n_lo = 0, n_hi = 0, n_ends = 0, n_all = 0;
     for (const auto& ep : eps)
       for (const auto& s : ep) {
         const double g = s.raw[kGripper];
@@ -464,15 +469,24 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         hi = std::max(hi, g);
         n_lo += g < 0.1;
         n_hi += g > 0.9;
+        n_ends += std::abs(g) < 0.05 || std::abs(g - 1.0) < 0.05;
+        ++n_all;
       }
     if (hi - lo < 0.1) {
       range_reason = "the gripper command never changes; a log that opens and closes the gripper would decide";
     } else if (lo < -0.05) {
       range = GripperRange::kSymmetric;
       range_conf = 1.0;
-    } else if (hi <= 1.05 && n_lo > 0 && n_hi > 0) {
+    } else if (hi <= 1.05 && n_lo > 0 && n_hi > 0 && static_cast<double>(n_ends) >= 0.95 * static_cast<double>(n_all)) {
+      // binary commands at 0 and 1 only: a [0, 1] convention (a [-1, 1] policy would close at -1)
       range = GripperRange::kUnit;
       range_conf = 1.0;
+    } else if (hi <= 1.05) {
+      // continuous commands inside [0, 1] fit either range (a [-1, 1] policy that never closes fully,
+      // a learned policy's clipped outputs): the log cannot tell, and claims nothing
+      range_checked = false;
+      range_reason = "the gripper commands stay inside [0, 1] and take values between the ends: either range fits them; commands "
+                     "below 0, or only 0 and 1, would decide";
     } else {
       range_reason = "the gripper commands do not reach both ends of either range";
     }
@@ -550,12 +564,14 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         std::vector<int> lags;
         if (commands && ev.lag_resolved) lags.push_back(map_lag);
         else lags.assign(grammar::kLagGrid.begin(), grammar::kLagGrid.end());
-        double weakest = std::numeric_limits<double>::infinity();
+        double weakest = std::numeric_limits<double>::infinity(), best_r2 = 0;
         int sign = 0;
         bool agree = true;
         for (int lag : lags) {
-          Sums unused;
-          const double t = slope_t(lag, &unused);
+          Sums at;
+          const double t = slope_t(lag, &at);
+          const double cov = at.sxy - at.sx * at.sy / std::max(at.m, 1.0);
+          if (at.vx() > 0 && at.vy() > 0) best_r2 = std::max(best_r2, cov * cov / (at.vx() * at.vy()));
           const int sg = t > 0 ? 1 : (t < 0 ? -1 : 0);
           if (sign == 0) sign = sg;
           agree = agree && sg != 0 && sg == sign;
@@ -564,11 +580,15 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
         const double tc = ev.t_critical > 0 ? ev.t_critical : 3.0;
         const double zf = floor >= 1.0 ? 40.0 : detail::normal_quantile(floor);
         inverted = sign < 0;
-        polarity_conf = agree && weakest >= tc ? std::max(floor, normal_cdf(std::min(weakest, 1e6) * zf / tc)) : 0.0;
+        // the grammar's gripper sets the fingers' target: they follow the command closely (R² well above
+        // a half); fingers that mostly move otherwise (contacts, a cube between them) carry a polarity
+        // only by accident
+        polarity_conf = agree && weakest >= tc && best_r2 >= kMinFingerR2 ? std::max(floor, normal_cdf(std::min(weakest, 1e6) * zf / tc)) : 0.0;
         if (polarity_conf < floor)
           polarity_reason = "the fingers follow the gripper command too weakly or inconsistently over the log's parts (t = " +
-                            fmt("%.2f", agree ? weakest : 0.0) + ", " + fmt("%.2f", tc) +
-                            " needed); more open and close commands would decide";
+                            fmt("%.2f", agree ? weakest : 0.0) + ", " + fmt("%.2f", tc) + " needed; the command explains " +
+                            fmt("%.0f", 100 * best_r2) + " % of the finger positions, " + fmt("%.0f", 100 * kMinFingerR2) +
+                            " % needed); more open and close commands would decide";
       }
     }
   } else {
@@ -842,7 +862,7 @@ AuditResult audit(const ActionLog& log, const AuditOptions& o) {
                             polarity_conf, polarity_checked, polarity_reason,
                             "gripper polarity differs: declared " + grip_words(dc.gripper_inverted()) + ", the fingers show " +
                                 grip_words(id.contract.gripper_inverted())));
-  R.fields.push_back(scalar("gripper_range", to_string(o.declared.gripper_range), to_string(id.gripper_range), range_conf, log.has_gripper,
+  R.fields.push_back(scalar("gripper_range", to_string(o.declared.gripper_range), to_string(id.gripper_range), range_conf, range_checked,
                             range_reason,
                             "gripper range differs: declared " + std::string(to_string(o.declared.gripper_range)) + ", the logged gripper commands span " +
                                 to_string(id.gripper_range)));

@@ -810,6 +810,23 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
     out.routed = routed;
     out.sign_committed = routed && signed_;
   }
+  // a raw channel drives one output channel: a committed channel whose raw channel also explains a
+  // large share of another output channel's motion (more than --max-coupling of the share it explains
+  // here) is a coupling (pulling the cube towards the base tilts the tool), and is not committed
+  for (int i = 0; i < kPoseDim; ++i) {
+    auto& a = ev.channel[static_cast<std::size_t>(i)];
+    if (!a.routed) continue;
+    for (int k = 0; k < kPoseDim; ++k) {
+      if (k == i || !(B.vy[k] > 0)) continue;
+      const double share = std::pow(B.beta(a.raw, k), 2) * std::max(B.sx2(k, a.raw), 0.0) / B.vy[k];
+      if (share > o.max_coupling * a.explained) {
+        a.routed = a.sign_committed = false;
+        a.why = "raw channel " + std::to_string(a.raw) + " also explains " + fmt_g(100 * share) + " % of output channel " + kName[k] +
+                "'s motion (" + fmt_g(100 * a.explained) + " % of this one's): a coupling, not a wiring one to one";
+        break;
+      }
+    }
+  }
   // a permutation reads each raw channel once: a channel whose read raw channel drives another output
   // channel more strongly (a physical coupling: pulling down turns the tool) is not committed
   for (int i = 0; i < kPoseDim; ++i)

@@ -516,6 +516,48 @@ TEST(AuditHeldOut, FingersThatNeverMoveCarryNoPolarity) {
   EXPECT_THAT(field(r, "gripper_inverted").reason, HasSubstr("never move"));
 }
 
+TEST(AuditHeldOut, ContinuousGripperCommandsInsideZeroOneFitEitherRange) {
+  // a [-1, 1] policy that never closes below 0 (clipped learned outputs): its commands stay inside
+  // [0, 1] and take values between the ends, which the [0, 1] convention would read as well; the
+  // first benchmarked model called it [0, 1] (the benchmark's MLP logs)
+  ActionLog log = synthetic_log(conv(Contract::identity()), model(), {});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (auto& ep : log.episodes)
+    for (auto& a : ep.actions) a[kGripper] = u01(rng);
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  EXPECT_FALSE(field(r, "gripper_range").checked) << to_text(r);
+  EXPECT_THAT(field(r, "gripper_range").reason, HasSubstr("either range fits"));
+  EXPECT_NE(r.status, Status::kMismatch) << to_text(r);
+  // binary commands at 0 and 1 only: the [0, 1] convention
+  for (auto& ep : log.episodes)
+    for (auto& a : ep.actions) a[kGripper] = u01(rng) < 0.5 ? 0.0 : 1.0;
+  EXPECT_EQ(field(audit(log, o), "gripper_range").identified, "[0, 1]");
+}
+
+TEST(AuditHeldOut, FingersThatMostlyMoveOtherwiseCarryNoPolarity) {
+  // fingers driven by something other than the command (a cube between them, contacts), with a weak
+  // opposite trace of the command: the first benchmarked model read "inverted" from such a log
+  ActionLog log = synthetic_log(conv(Contract::identity()), model(), {});
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> n01;
+  for (auto& ep : log.episodes) {
+    double wander = 0.02;
+    for (std::size_t t = 0; t + 1 < ep.poses.size(); ++t) {
+      wander = std::clamp(wander + 0.002 * n01(rng), 0.0, 0.04);
+      const double f = wander - 0.001 * ep.actions[t][kGripper];
+      ep.poses[t + 1].fingers = Eigen::Vector2d(f, f);
+    }
+  }
+  AuditOptions o;
+  o.model = model();
+  const AuditResult r = audit(log, o);
+  EXPECT_FALSE(r.committed_gripper_inverted.has_value()) << to_text(r);
+  EXPECT_THAT(field(r, "gripper_inverted").reason, HasSubstr("% of the finger positions")) << to_text(r);
+}
+
 TEST(AuditHeldOut, AVerdictNeverCitesAFieldItAlsoCallsUndecided) {
   // a MISMATCH that commits some channels of a field lists the other channels, not the field, as undecided
   SyntheticLogOptions lo;
