@@ -93,8 +93,9 @@ def page_text(page, binary, tmp):
         subprocess.run([sys.executable, "scripts/audit_report.py", "--out", out, "--svg", f"{tmp}/audit.svg", "--tuning", f"{d}/tuning",
                         "--chosen", chosen, "--evaluation", f"{d}/evaluation", "--old", f"{d}/previous", "--old-commit", "d9c0511",
                         "--command", f"scripts/audit_benchmark {d}", "--commit", "0000000", "--wall", "12",
-                        "--tuning-seeds", "20260901 20260902", "--eval-seeds", "20260911 20260912", "--lengths", "50 200",
-                        "--eval-committed", "37eea8d"], check=True, cwd=ROOT, env=env, capture_output=True)
+                        "--tuning-seeds", "20260901 20260902", "--eval-seeds", "20260921 20260922", "--lengths", "50 200",
+                        "--eval-committed", "e674eac", "--spent", f"{d}/evaluation", "--first-round", f"{d}/previous",
+                        "--spent-seeds", "20260911 20260912"], check=True, cwd=ROOT, env=env, capture_output=True)
         return open(out).read() + "\n<!-- svg -->\n" + open(f"{tmp}/audit.svg").read()
     raise SystemExit(f"run_page_test: unknown page {page}")
 
