@@ -652,7 +652,7 @@ def _one_line(e, limit=120):
 
 
 def audit(log=None, *, actions=None, tcp_pos=None, tcp_quat=None, fingers=None, episode=None, declared="identity",
-          model=None, confidence_floor=0.99, misspec_ratio=25.0, gain_tolerance=1.8):
+          model=None, confidence_floor=0.99, misspec_ratio=25.0, gain_tolerance=5.0):
     """Audit a log: the action contract of recorded data (docs/audit.md). Returns the report as a dict
     (the keys of `actionshift audit --json`: status PASS/MISMATCH/INCONCLUSIVE, reason, fields, ...).
 
