@@ -87,7 +87,9 @@ struct ActionLog {
   std::string layout{"columns"};     ///< "csv", "jsonl", "maniskill", "robomimic", "arrays"
   /// A declaration the file carries (ManiSkill's sidecar control_mode), if the reader understood one.
   std::optional<Conventions> declared;
-  std::string declared_from;         ///< where `declared` came from, e.g. "control_mode pd_ee_delta_pose"
+  /// where `declared` came from, e.g. "control_mode pd_ee_delta_pose"; set while `declared` is empty, why the
+  /// file's own declaration was not taken (e.g. a robosuite controller with absolute targets)
+  std::string declared_from;
 
   std::size_t transitions() const;   ///< steps with a measured response
   /// The first `max_transitions` transitions (whole episodes, the last one cut).
