@@ -77,13 +77,8 @@ std::string action_words(ActionKind a) {
   }
 }
 
-const char* kChannel[kPoseDim] = {"x", "y", "z", "rx", "ry", "rz"};
-
-std::string fmt(const char* f, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
+using detail::fmt;
+using detail::kChannel;
 
 std::string join(const std::vector<std::string>& v, const char* sep) {
   std::string s;

@@ -9,11 +9,22 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace actionshift::selftest::detail {
+
+/// The output channels' names, for the reports.
+inline constexpr const char* kChannel[kPoseDim] = {"x", "y", "z", "rx", "ry", "rz"};
+
+/// One number through a printf format ("%.3g"), for the reports.
+inline std::string fmt(const char* f, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, x);
+  return buf;
+}
 
 /// One transition of a log: the action logged at t and the pose change it was followed by.
 struct Step {

@@ -473,14 +473,6 @@ std::string mode_words(const Mode& m) {
   return std::string(to_string(m.target)) + "/" + (m.frame ? "tool" : "base") + "/lag " + std::to_string(m.lag);
 }
 
-const char* kName[kPoseDim] = {"x", "y", "z", "rx", "ry", "rz"};
-
-
-std::string fmt_g(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
 
 }  // namespace
 
@@ -716,16 +708,16 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
     if (excitation[aa] < o.min_excitation || (!(std::abs(c.t) >= tc) && !idle.empty())) {
       std::string list;
       for (int j : idle) list += (list.empty() ? "" : ", ") + std::to_string(j);
-      c.why = "raw channel(s) " + list + " hardly move (RMS command < " + fmt_g(o.min_excitation) + ")";
+      c.why = "raw channel(s) " + list + " hardly move (RMS command < " + fmt("%.3g", o.min_excitation) + ")";
       return c;
     }
     if (!(channel_null_t[static_cast<std::size_t>(i)] >= tc)) {
-      c.why = "the commands do not explain its motion better than ignoring them (paired t = " + fmt_g(channel_null_t[static_cast<std::size_t>(i)]) + ")";
+      c.why = "the commands do not explain its motion better than ignoring them (paired t = " + fmt("%.3g", channel_null_t[static_cast<std::size_t>(i)]) + ")";
       return c;
     }
     if (!(std::abs(c.t) >= tc)) {
-      c.why = "its coefficient on " + ch + " does not stand out of its uncertainty over the log's parts (t = " + fmt_g(std::abs(c.t)) + ", " +
-              fmt_g(tc) + " needed): the parts disagree or the motion is small; more episodes would decide";
+      c.why = "its coefficient on " + ch + " does not stand out of its uncertainty over the log's parts (t = " + fmt("%.3g", std::abs(c.t)) + ", " +
+              fmt("%.3g", tc) + " needed): the parts disagree or the motion is small; more episodes would decide";
       return c;
     }
     if (c.explained < o.min_explained) {
@@ -734,7 +726,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
       return c;
     }
     if (o.calibrated && c.gain + 2 * c.se < 0.5 / o.gain_tolerance) {
-      c.why = "its response to " + ch + " is " + fmt_g(c.gain) +
+      c.why = "its response to " + ch + " is " + fmt("%.3g", c.gain) +
               "x the calibrated gain, too weak for any contract of the grammar: the motion is not driven by that command";
       return c;
     }
@@ -765,7 +757,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
     }
     const double first = c.gain * std::sqrt(std::max(f.sx2(i, arg), 0.0));
     if (second_j >= 0 && second > o.max_coupling * first) {
-      c.why = "raw channel " + std::to_string(second_j) + " moves it at " + fmt_g(second / std::max(first, 1e-300)) + "x the amplitude " + ch +
+      c.why = "raw channel " + std::to_string(second_j) + " moves it at " + fmt("%.3g", second / std::max(first, 1e-300)) + "x the amplitude " + ch +
               " does: the channels are coupled (contacts, a closed loop's reactions), not wired one to one";
       return c;
     }
@@ -821,8 +813,8 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
       const double share = std::pow(B.beta(a.raw, k), 2) * std::max(B.sx2(k, a.raw), 0.0) / B.vy[k];
       if (share > o.max_coupling * a.explained) {
         a.routed = a.sign_committed = false;
-        a.why = "raw channel " + std::to_string(a.raw) + " also explains " + fmt_g(100 * share) + " % of output channel " + kName[k] +
-                "'s motion (" + fmt_g(100 * a.explained) + " % of this one's): a coupling, not a wiring one to one";
+        a.why = "raw channel " + std::to_string(a.raw) + " also explains " + fmt("%.3g", 100 * share) + " % of output channel " + kChannel[k] +
+                "'s motion (" + fmt("%.3g", 100 * a.explained) + " % of this one's): a coupling, not a wiring one to one";
         break;
       }
     }
@@ -835,7 +827,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
       const auto& b = ev.channel[static_cast<std::size_t>(k)];
       if (i == k || !a.routed || b.raw != a.raw || std::abs(b.t) <= std::abs(a.t)) continue;
       a.routed = a.sign_committed = false;
-      a.why = "raw channel " + std::to_string(a.raw) + " drives output channel " + kName[k] + " more strongly (a coupling, or " + kName[k] +
+      a.why = "raw channel " + std::to_string(a.raw) + " drives output channel " + kChannel[k] + " more strongly (a coupling, or " + kChannel[k] +
               " reads it)";
     }
   for (int i = 0; i < kPoseDim; ++i)
@@ -844,7 +836,7 @@ Evidence identify(const Episodes& eps, const std::array<double, kPoseDim>& excit
       auto& b = ev.channel[static_cast<std::size_t>(k)];
       if (a.routed && b.routed && a.raw == b.raw) {
         a.routed = b.routed = a.sign_committed = b.sign_committed = false;
-        a.why = b.why = std::string("output channels ") + kName[i] + " and " + kName[k] + " both read raw channel " + std::to_string(a.raw);
+        a.why = b.why = std::string("output channels ") + kChannel[i] + " and " + kChannel[k] + " both read raw channel " + std::to_string(a.raw);
       }
     }
   // the best mode's most likely permutation (largest Σ|t|), signs and gains
